@@ -1,0 +1,70 @@
+"""`tg-drake bench`: speed figures, each a ratio against a reference measured in the same run.
+
+Each figure is a function returning a `Figure`; stages register theirs in FIGURES (name → "module:function").
+Output: one JSON object, figure name → {median, unit, reference, reference_median, speedup}.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import statistics
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Callable
+
+HELP = "measure the speed figures (JSON of medians and ratios against references)"
+
+# figure name → "module:function" returning a Figure. Order is the output order.
+FIGURES: dict[str, str] = {
+}
+
+
+@dataclass
+class Figure:
+    median: float
+    unit: str
+    reference: str | None = None  # what the reference is
+    reference_median: float | None = None
+    speedup: float | None = None  # reference_median / median (> 1: we are faster)
+
+
+def median_time(fn: Callable[[], object], *, repeats: int = 5, warmup: int = 1) -> float:
+    """Median wall time of `fn()` over `repeats` calls, after `warmup` untimed calls [s]."""
+    for _ in range(warmup):
+        fn()
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def figure(median: float, unit: str, reference: str | None = None,
+           reference_median: float | None = None) -> Figure:
+    speedup = (reference_median / median) if (reference_median and median) else None
+    return Figure(median, unit, reference, reference_median, speedup)
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--out", type=Path, help="write the JSON here (also printed)")
+    parser.add_argument("--only", action="append", choices=sorted(FIGURES),
+                        help="run only this figure (repeatable)")
+
+
+def main(args) -> int:
+    names = args.only or list(FIGURES)
+    results = {}
+    for name in names:
+        module_name, function_name = FIGURES[name].split(":")
+        fn = getattr(importlib.import_module(module_name), function_name)
+        results[name] = asdict(fn())
+        print(f"{name}: {results[name]}", flush=True)
+    text = json.dumps(results, indent=2)
+    if args.out:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        args.out.write_text(text + "\n")
+    print(text)
+    return 0

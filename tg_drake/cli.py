@@ -1,0 +1,44 @@
+"""The `tg-drake` command.
+
+Each subcommand lives in the module that owns its work; this file only dispatches. A module listed
+in COMMANDS provides `add_arguments(parser)` and `main(args) -> int` and a one-line `HELP`.
+Modules are imported only when their command runs, so `tg-drake objects` never loads ProbLog.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from tg_drake.errors import TgDrakeError
+
+# command name → module implementing it.
+COMMANDS: dict[str, str] = {
+    "bench": "tg_drake.bench",
+}
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="tg-drake", description="Task-dependent robot grasping in Drake.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name, module_name in COMMANDS.items():
+        module = importlib.import_module(module_name)
+        p = sub.add_parser(name, help=module.HELP, description=module.HELP)
+        module.add_arguments(p)
+        p.set_defaults(_module=module)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        return int(args._module.main(args) or 0)
+    except TgDrakeError as e:
+        print(f"tg-drake {args.command}: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
