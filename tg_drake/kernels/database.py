@@ -1,0 +1,203 @@
+"""The object database of the kernel prior and the prior query against it.
+
+The database holds, per sampled graph of the object library, its hashed features φ(G_t) for
+t = 0..15 (not the raw graphs), the LSH projections that made them (queries must hash with the
+same ones), the resampling density and the T chosen by leave-one-object-out evaluation.
+`tools/build_kernel_db.py` writes it to `tg_drake/data/kernel_db.npz`; `load_default_database()`
+reads that file once per process.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.resources
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+
+from tg_drake.errors import KernelError, unknown_name
+from tg_drake.kernels.graph import (
+    K_NEIGHBOURS, LabelledCloud, cloud_transition, validate_cloud, voxel_resample)
+from tg_drake.kernels.prior import N_NEIGHBOURS, category_priors
+from tg_drake.kernels.propagation import (
+    FeatureCounts, LshProjections, graph_features, propagation_hashes)
+from tg_drake.types import CATEGORIES, PART_LABELS, CategoryDistribution
+
+FORMAT_VERSION = 1
+DEFAULT_DATABASE = "data/kernel_db.npz"  # inside the tg_drake package.
+
+
+@dataclass
+class KernelPriorConfig:
+    """Parameters of the kernel prior stage."""
+
+    iterations: int | None = None  # T of K_T; None: the database's T (best leave-one-out accuracy).
+    n_neighbours: int = N_NEIGHBOURS  # n most similar database graphs averaged into the prior.
+    database: str | None = None  # path of a kernel_db.npz; None: the one shipped in tg_drake/data.
+
+
+@dataclass
+class KernelDatabase:
+    """Hashed propagation-kernel features of labelled object graphs, with their categories."""
+
+    object_ids: np.ndarray  # (G,) str: library object of each graph (several graphs per object).
+    categories: np.ndarray  # (G,) int: index into CATEGORIES.
+    features: FeatureCounts  # φ(G_t) for t = 0..t_max.
+    projections: LshProjections  # the LSH projections of database and queries.
+    spacing: float  # [m] voxel size clouds are resampled to before their graph is built.
+    k: int = K_NEIGHBOURS  # neighbours per node in the k-nn graph.
+    t_default: int = 0  # T used when a query gives none.
+
+    def __post_init__(self):
+        self._self_kernels = self.features.self_kernels()
+
+    @property
+    def t_max(self) -> int:
+        return self.features.t_max
+
+    @classmethod
+    def build(cls, clouds: list[LabelledCloud], object_ids, categories, *,
+              projections: LshProjections, spacing: float, k: int = K_NEIGHBOURS,
+              t_default: int = 0) -> KernelDatabase:
+        """Hashes already resampled clouds into a database (one block-diagonal diffusion)."""
+        ids = np.asarray(object_ids, dtype=str)
+        cats = np.asarray(categories, dtype=np.int64)
+        if not (len(clouds) == len(ids) == len(cats)):
+            raise KernelError(f"{len(clouds)} clouds, {len(ids)} object ids and {len(cats)} "
+                              "categories: one of each per graph")
+        if len(clouds) == 0:
+            raise KernelError("an empty kernel database: give at least one cloud")
+        transitions = [cloud_transition(c, k=k) for c in clouds]
+        features = graph_features(transitions, [c.labels for c in clouds], projections)
+        return cls(ids, cats, features, projections, float(spacing), k, int(t_default))
+
+    # -- queries ---------------------------------------------------------------------------
+
+    def _iterations(self, t: int | None) -> int:
+        t = self.t_default if t is None else int(t)
+        if not 0 <= t <= self.t_max:
+            raise KernelError(f"iterations T = {t} out of range; allowed: 0..{self.t_max}")
+        return t
+
+    def prepare(self, points, normals, labels) -> LabelledCloud:
+        """Validates a query cloud and resamples it to the database's density."""
+        cloud = validate_cloud(points, normals, labels, k=self.k)
+        resampled = voxel_resample(cloud, self.spacing)
+        if resampled.points.shape[0] < self.k + 1:
+            raise KernelError(
+                f"a cloud of {resampled.points.shape[0]} point(s) after resampling at "
+                f"{self.spacing * 1e3:.1f} mm is too small: the k-nn graph with k = {self.k} "
+                f"needs at least {self.k + 1} points")
+        return resampled
+
+    def similarities(self, points, normals, labels, *, t: int | None = None) -> np.ndarray:
+        """(G,) K̂_T between the query cloud and every database graph."""
+        t = self._iterations(t)
+        cloud = self.prepare(points, normals, labels)
+        hashes = propagation_hashes(cloud_transition(cloud, k=self.k), cloud.labels,
+                                    self.projections, t_max=t)
+        row, self_k = self.features.cross(hashes)
+        return row[t] / np.sqrt(self_k[t] * self._self_kernels[t])
+
+    def prior(self, points, normals, labels, *, t: int | None = None,
+              n_neighbours: int = N_NEIGHBOURS, exclude_object: str | None = None
+              ) -> CategoryDistribution:
+        """The category prior of one cloud: the n most similar graphs weighted by exp(−rank).
+
+        `exclude_object` leaves every graph of that library object out (leave-one-object-out).
+        """
+        sim = self.similarities(points, normals, labels, t=t)
+        if exclude_object is not None:
+            if exclude_object not in set(self.object_ids.tolist()):
+                raise unknown_name("database object", exclude_object,
+                                   sorted(set(self.object_ids.tolist())), error=KernelError)
+            sim = np.where(self.object_ids == exclude_object, -np.inf, sim)
+        priors, neighbours = category_priors(sim, self.categories, n_neighbours=n_neighbours)
+        return CategoryDistribution(
+            probabilities=priors[0],
+            neighbours=[(str(self.object_ids[j]), CATEGORIES[self.categories[j]], float(sim[j]))
+                        for j in neighbours[0] if np.isfinite(sim[j])])
+
+    # -- file ------------------------------------------------------------------------------
+
+    def save(self, path: str | Path) -> None:
+        """Writes the database as a compressed .npz to a path or binary file (counts as small
+        integers)."""
+        f = self.features
+        max_count = max(int(c.data.max()) for c in f.counts)
+        arrays = dict(
+            format_version=np.array(FORMAT_VERSION),
+            category_names=np.array(CATEGORIES), part_labels=np.array(PART_LABELS),
+            object_ids=self.object_ids, categories=self.categories.astype(np.int16),
+            proj_v=self.projections.v, proj_b=self.projections.b,
+            w=np.array(self.projections.w), spacing=np.array(self.spacing),
+            k=np.array(self.k), t_default=np.array(self.t_default),
+            vocab_sizes=np.array([len(v) for v in f.vocabularies], dtype=np.int64),
+            vocab=np.concatenate(f.vocabularies),
+            # Per bin (column): how many graphs have it; then those graphs and their counts.
+            column_nnz=np.concatenate([np.diff(c.indptr) for c in f.counts]).astype(
+                np.uint16 if f.n_graphs < 2 ** 16 else np.uint32),
+            graph_ids=np.concatenate([c.indices for c in f.counts]).astype(
+                np.uint16 if f.n_graphs < 2 ** 16 else np.uint32),
+            counts=np.concatenate([c.data for c in f.counts]).astype(
+                np.uint16 if max_count < 2 ** 16 else np.uint32),
+        )
+        np.savez_compressed(path, **arrays)
+
+    @classmethod
+    def load(cls, path) -> KernelDatabase:
+        """Reads a database written by `save` (a path or a binary file object)."""
+        try:
+            data = np.load(path, allow_pickle=False)
+        except (OSError, ValueError) as e:
+            raise KernelError(f"cannot read the kernel database: {e}", file=str(path)) from None
+        with data:
+            if int(data["format_version"]) != FORMAT_VERSION:
+                raise KernelError(f"kernel database format {int(data['format_version'])}, "
+                                  f"expected {FORMAT_VERSION}; rebuild it with "
+                                  "tools/build_kernel_db.py", file=str(path))
+            if tuple(data["category_names"].tolist()) != CATEGORIES or \
+                    tuple(data["part_labels"].tolist()) != PART_LABELS:
+                raise KernelError("kernel database built for other categories or part labels; "
+                                  "rebuild it with tools/build_kernel_db.py", file=str(path))
+            n_graphs = data["object_ids"].shape[0]
+            sizes = data["vocab_sizes"]
+            vocab_ends = np.cumsum(sizes)
+            vocabularies = np.split(data["vocab"], vocab_ends[:-1])
+            column_nnz = np.split(data["column_nnz"].astype(np.int64), vocab_ends[:-1])
+            nnz_ends = np.cumsum([c.sum() for c in column_nnz])
+            graph_ids = np.split(data["graph_ids"].astype(np.int32), nnz_ends[:-1])
+            counts = np.split(data["counts"].astype(np.float64), nnz_ends[:-1])
+            matrices = [
+                sp.csc_matrix((cnt, gid, np.concatenate([[0], np.cumsum(nnz)])),
+                              shape=(n_graphs, len(voc)))
+                for voc, nnz, gid, cnt in zip(vocabularies, column_nnz, graph_ids, counts)]
+            return cls(
+                object_ids=data["object_ids"].astype(str),
+                categories=data["categories"].astype(np.int64),
+                features=FeatureCounts(vocabularies, matrices),
+                projections=LshProjections(v=data["proj_v"], b=data["proj_b"],
+                                           w=float(data["w"])),
+                spacing=float(data["spacing"]), k=int(data["k"]),
+                t_default=int(data["t_default"]))
+
+
+@functools.lru_cache(maxsize=4)
+def _load_cached(path: str | None) -> KernelDatabase:
+    if path is not None:
+        if not Path(path).is_file():
+            raise KernelError("kernel database not found", file=path)
+        return KernelDatabase.load(path)
+    resource = importlib.resources.files("tg_drake").joinpath(DEFAULT_DATABASE)
+    if not resource.is_file():
+        raise KernelError("the shipped kernel database is missing; build it with "
+                          "`python tools/build_kernel_db.py`", file=f"tg_drake/{DEFAULT_DATABASE}")
+    with resource.open("rb") as fh:
+        return KernelDatabase.load(fh)
+
+
+def load_database(path: str | None = None) -> KernelDatabase:
+    """The kernel database at `path` (None: the one shipped with the package), loaded once."""
+    return _load_cached(None if path is None else str(Path(path).resolve()))
