@@ -22,8 +22,8 @@ SPACING = 0.008  # [m] voxel size of the test clouds: a few hundred points per o
 
 
 def _shapes(rng):
-    """Six labelled clouds of four kinds, resampled to SPACING."""
-    raw = [
+    """Six labelled clouds of four kinds, as sampled (dense)."""
+    return [
         synthetic.cylinder(radius=0.033, height=0.12, n=6000, rng=rng),
         synthetic.cylinder(radius=0.035, height=0.11, n=6000, rng=rng),
         synthetic.mug(radius=0.04, height=0.10, n=6000, rng=rng),
@@ -32,12 +32,17 @@ def _shapes(rng):
                        n=6000, rng=rng),
         synthetic.box(size=(0.07, 0.07, 0.2), n=6000, rng=rng),
     ]
-    return [voxel_resample(c, SPACING) for c in raw]
 
 
 @pytest.fixture(scope="module")
-def clouds():
+def raw_clouds():
     return _shapes(np.random.default_rng(7))
+
+
+@pytest.fixture(scope="module")
+def clouds(raw_clouds):
+    """The clouds resampled to SPACING, as the database holds them."""
+    return [voxel_resample(c, SPACING) for c in raw_clouds]
 
 
 @pytest.fixture(scope="module")
@@ -88,10 +93,10 @@ def test_transition_rows_sum_to_one_and_isolated_nodes_keep_their_labels():
     np.testing.assert_array_equal(t, [[0, 1, 0], [1, 0, 0], [0, 0, 1]])
 
 
-def test_voxel_resample_keeps_one_real_point_per_cell(clouds):
+def test_voxel_resample_keeps_one_real_point_per_cell():
     dense = synthetic.cylinder(radius=0.03, height=0.1, n=20000, rng=np.random.default_rng(0))
     out = voxel_resample(dense, 0.01)
-    cells = np.floor(out.points / 0.01).astype(int)
+    cells = np.floor((out.points - dense.points.min(axis=0)) / 0.01).astype(int)
     assert len(np.unique(cells, axis=0)) == len(out.points)
     # The kept points are input points, with their own normals and labels.
     idx = np.array([np.flatnonzero(np.all(dense.points == q, axis=1))[0] for q in out.points[:50]])
@@ -255,18 +260,18 @@ def database(clouds, projections):
                                 cats, projections=projections, spacing=SPACING, t_default=4)
 
 
-def test_query_row_equals_kernel_matrix_row(database, features, clouds):
+def test_query_row_equals_kernel_matrix_row(database, features, raw_clouds):
     k_hat = normalise(features.kernel())
-    c = clouds[3]
+    c = raw_clouds[3]
     for t in (0, 4, 15):
-        # Resampling a resampled cloud on the same grid keeps it, so the query is graph 3;
+        # The query resamples the raw cloud as the database did, so it is graph 3;
         # rtol 1e-12: the same sums in another order.
         np.testing.assert_allclose(database.similarities(c.points, c.normals, c.labels, t=t),
                                    k_hat[t, 3], rtol=1e-12)
 
 
-def test_prior_of_a_database_member_names_itself_first(database, clouds):
-    c = clouds[2]
+def test_prior_of_a_database_member_names_itself_first(database, raw_clouds):
+    c = raw_clouds[2]
     d = database.prior(c.points, c.normals, c.labels)
     assert d.neighbours[0][:2] == ("cup1", "cup")
     assert d.neighbours[0][2] == pytest.approx(1.0, rel=1e-12)
@@ -278,7 +283,7 @@ def test_prior_of_a_database_member_names_itself_first(database, clouds):
     assert max(d.as_dict(), key=d.as_dict().get) == "cup"
 
 
-def test_database_round_trip(database, clouds):
+def test_database_round_trip(database, raw_clouds):
     buf = io.BytesIO()
     database.save(buf)
     buf.seek(0)
@@ -286,7 +291,7 @@ def test_database_round_trip(database, clouds):
     np.testing.assert_array_equal(loaded.object_ids, database.object_ids)
     np.testing.assert_array_equal(loaded.projections.v, database.projections.v)
     assert (loaded.spacing, loaded.k, loaded.t_default) == (SPACING, 4, 4)
-    c = clouds[5]
+    c = raw_clouds[5]
     np.testing.assert_array_equal(loaded.similarities(c.points, c.normals, c.labels, t=9),
                                   database.similarities(c.points, c.normals, c.labels, t=9))
 
@@ -296,3 +301,13 @@ def test_loading_garbage_is_a_kernel_error(tmp_path):
     bad.write_bytes(b"not a zip file")
     with pytest.raises(KernelError, match="cannot read the kernel database"):
         KernelDatabase.load(bad)
+
+
+def test_resampling_follows_a_moved_cloud(raw_clouds):
+    c = raw_clouds[2]
+    moved = LabelledCloud(c.points + np.array([0.5037, -0.2011, 0.7993]), c.normals, c.labels)
+    a, b = voxel_resample(c, SPACING), voxel_resample(moved, SPACING)
+    np.testing.assert_array_equal(a.labels, b.labels)
+    shift = np.broadcast_to([0.5037, -0.2011, 0.7993], a.points.shape)
+    # 1e-15 m: float rounding of the shifted coordinates.
+    np.testing.assert_allclose(b.points - a.points, shift, rtol=0, atol=1e-15)

@@ -75,14 +75,14 @@ class KernelDatabase:
 
     # -- queries ---------------------------------------------------------------------------
 
-    def _iterations(self, t: int | None) -> int:
+    def resolve_iterations(self, t: int | None) -> int:
         t = self.t_default if t is None else int(t)
         if not 0 <= t <= self.t_max:
             raise KernelError(f"iterations T = {t} out of range; allowed: 0..{self.t_max}")
         return t
 
     def prepare(self, points, normals, labels) -> LabelledCloud:
-        """Validates a query cloud and resamples it to the database's density."""
+        """Validates a query cloud and resamples it to the database's density (`spacing`)."""
         cloud = validate_cloud(points, normals, labels, k=self.k)
         resampled = voxel_resample(cloud, self.spacing)
         if resampled.points.shape[0] < self.k + 1:
@@ -94,7 +94,7 @@ class KernelDatabase:
 
     def similarities(self, points, normals, labels, *, t: int | None = None) -> np.ndarray:
         """(G,) K̂_T between the query cloud and every database graph."""
-        t = self._iterations(t)
+        t = self.resolve_iterations(t)
         cloud = self.prepare(points, normals, labels)
         hashes = propagation_hashes(cloud_transition(cloud, k=self.k), cloud.labels,
                                     self.projections, t_max=t)

@@ -123,13 +123,14 @@ def voxel_resample(cloud: LabelledCloud, spacing: float, *,
 
     Brings clouds of any density to the density of the database, so that T diffusion steps
     span the same surface distance in the query and in the database. The kept points are real
-    points, so their normals and labels are kept unchanged. `offset` [m] shifts the grid (the
+    points, so their normals and labels are kept unchanged. The grid starts at the cloud's lowest
+    corner, so a moved cloud resamples the same; `offset` [m] shifts the grid from there (the
     database tool varies it to get different samplings of one object).
     """
     if not spacing > 0:
         raise KernelError(f"voxel spacing must be positive, got {spacing}")
     shift = np.zeros(3) if offset is None else np.asarray(offset, dtype=np.float64)
-    scaled = (cloud.points + shift) / spacing
+    scaled = (cloud.points - cloud.points.min(axis=0) + shift) / spacing
     cell = np.floor(scaled).astype(np.int64)
     dist = np.sum((scaled - cell - 0.5) ** 2, axis=1)
     # Sort by cell, then by distance to the cell centre; the first of each cell is kept.
