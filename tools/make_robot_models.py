@@ -104,7 +104,7 @@ def iiwa_urdf() -> str:
            "<!-- KUKA LBR iiwa 14 R820, written by tools/make_robot_models.py from",
            "     ../shared/robot_facts.md: 7 revolute joints about their local z axes, primitive",
            "     collision cylinders. Do not edit by hand. -->",
-           '<robot name="iiwa14">',
+           '<robot name="iiwa14" xmlns:drake="http://drake.mit.edu">',
            '  <material name="iiwa_orange"><color rgba="' + IIWA_ORANGE + '"/></material>',
            '  <material name="iiwa_grey"><color rgba="0.4 0.4 0.4 1"/></material>']
     for link, (mass, com, inertia, shape) in IIWA_LINKS.items():
@@ -138,6 +138,15 @@ def iiwa_urdf() -> str:
     out.append('  <joint name="iiwa_joint_ee" type="fixed">\n'
                '    <parent link="iiwa_link_7"/>\n    <child link="iiwa_link_ee"/>\n'
                '    <origin xyz="0 0 0.045" rpy="0 0 0"/>\n  </joint>')
+    # The coarse collision cylinders of links two apart overlap in normal postures; the real arm's
+    # links do not collide there, so those pairs are filtered (groups of three consecutive links).
+    links = list(IIWA_LINKS)
+    for i in range(len(links) - 2):
+        group = f"iiwa_links_{i}_{i + 2}"
+        members = "".join(f'<drake:member link="{link}"/>' for link in links[i:i + 3])
+        out.append(f'  <drake:collision_filter_group name="{group}">{members}'
+                   f'<drake:ignored_collision_filter_group name="{group}"/>'
+                   "</drake:collision_filter_group>")
     out.append("</robot>")
     return "\n".join(out) + "\n"
 

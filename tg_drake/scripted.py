@@ -1,0 +1,132 @@
+"""A scripted grasp-and-lift in the station, with no perception or reasoning.
+
+Used by the station tests (does the WSG hold a can / a cup body?) and by `tg-drake bench` for the
+`sim_rtf` figure. The gripper approaches the object's side horizontally from the robot's side,
+closes across the object at a chosen height, and the arm lifts it.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.math import RigidTransform
+from pydrake.multibody.plant import ContactResults
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
+
+from tg_drake.errors import PlanningError
+from tg_drake.planning.ik import make_arm_plant, solve_ik
+from tg_drake.scenario import IIWA_HOME, Scenario
+from tg_drake.station import add_station, rotation_from_axes
+
+GRASP_DEPTH = 0.055  # [m] the grasp point lies this far along +y_G from the WSG body origin.
+
+
+@dataclass
+class GraspLiftResult:
+    held: bool  # the object rose with the gripper and the fingers did not close on air
+    object_rise: float  # [m] object height change between grasp and end of lift
+    gripper_rise: float  # [m] gripper height change over the same interval
+    finger_opening: float  # [m] at the end
+    hydroelastic_surfaces: int  # contact surfaces touching the object at the end
+    sim_time: float  # [s] simulated
+    wall_time: float  # [s] of AdvanceTo, excluding building
+    render_time: float  # [s] rendering the camera frame at the start
+
+
+def side_grasp_pose(p_WO_center, approach_W=(1.0, 0.0, 0.0), *, pitch: float = 0.0
+                    ) -> RigidTransform:
+    """X_WG for a side grasp whose grasp point is at `p_WO_center`: the fingers close horizontally;
+    the approach is `approach_W` projected on the horizontal and tilted `pitch` [rad] downwards
+    (a downward tilt keeps the wrist clear of the table for low grasps)."""
+    horizontal = np.array([approach_W[0], approach_W[1], 0.0], float)
+    horizontal /= np.linalg.norm(horizontal)
+    approach = np.cos(pitch) * horizontal + np.array([0.0, 0.0, -np.sin(pitch)])
+    closing = np.cross([0.0, 0.0, 1.0], horizontal)  # horizontal, perpendicular to the approach
+    R_WG = rotation_from_axes(closing, approach)
+    return RigidTransform(R_WG, np.asarray(p_WO_center) - GRASP_DEPTH * approach)
+
+
+def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: float = 0.10,
+                   pitch: float = np.deg2rad(30), render: bool = True,
+                   width_closed: float = 0.0) -> GraspLiftResult:
+    """Runs the scripted grasp-and-lift on `object_name`, grasping at world point `p_W_grasp`."""
+    builder = DiagramBuilder()
+    station = add_station(builder, scenario=scenario)
+    plant = station.plant
+
+    # Key poses of the gripper, then joint positions by IK on a kinematic arm model.
+    p = np.asarray(p_W_grasp, float)
+    approach = p - np.array([0.0, 0.0, p[2]])
+    approach[2] = 0.0
+    X_grasp = side_grasp_pose(p, approach, pitch=pitch)
+    y_G = X_grasp.rotation().col(1)
+    X_pre = RigidTransform(X_grasp.rotation(), X_grasp.translation() - 0.10 * y_G)
+    X_lift = RigidTransform(X_grasp.rotation(), X_grasp.translation() + [0, 0, lift])
+    arm = make_arm_plant(scenario)
+    qs = [np.asarray(IIWA_HOME)]
+    for name, X, min_distance in (("pre-grasp", X_pre, 0.005), ("grasp", X_grasp, None),
+                                  ("lift", X_lift, None)):
+        r = solve_ik(arm, X, q_seed=qs[-1], min_distance=min_distance)
+        if not r.success:
+            raise PlanningError(f"{name} pose unreachable: {r.reason}")
+        qs.append(r.q)
+
+    # Timeline [s]: approach, move in, close, lift, hold.
+    times = [0.0, 2.0, 3.0, 4.0, 5.5, 6.5]
+    q_knots = np.column_stack([qs[0], qs[1], qs[2], qs[2], qs[3], qs[3]])
+    q_traj = PiecewisePolynomial.FirstOrderHold(times, q_knots)
+    w_traj = PiecewisePolynomial.FirstOrderHold(
+        [0.0, 3.0, 3.8, times[-1]], np.array([[0.11, 0.11, width_closed, width_closed]]))
+    arm_source = builder.AddSystem(TrajectorySource(q_traj, output_derivative_order=1))
+    wsg_source = builder.AddSystem(TrajectorySource(w_traj))
+    builder.Connect(arm_source.get_output_port(), station.inputs["iiwa.desired_state"])
+    builder.Connect(wsg_source.get_output_port(), station.inputs["wsg.position"])
+    diagram = builder.Build()
+
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    plant.SetPositions(plant_context, station.instances["iiwa"], qs[0])
+    body = station.object_body(object_name)
+    G = plant.GetFrameByName("body", station.instances["wsg"])
+
+    render_time = 0.0
+    if render and station.cameras:
+        sensor = next(iter(station.cameras.values())).sensor
+        t0 = time.perf_counter()
+        sensor.depth_image_32F_output_port().Eval(sensor.GetMyContextFromRoot(context))
+        render_time = time.perf_counter() - t0
+
+    simulator.Initialize()
+    t0 = time.perf_counter()
+    simulator.AdvanceTo(times[3])
+    z_obj_grasp = body.EvalPoseInWorld(plant_context).translation()[2]
+    z_g_grasp = G.CalcPoseInWorld(plant_context).translation()[2]
+    simulator.AdvanceTo(times[-1])
+    wall = time.perf_counter() - t0
+
+    X_WO = body.EvalPoseInWorld(plant_context)
+    if not np.all(np.isfinite(X_WO.GetAsMatrix4())):
+        from tg_drake.errors import SimulationError
+        raise SimulationError("the simulation diverged (non-finite object pose)")
+    q_wsg = plant.GetPositions(plant_context, station.instances["wsg"])
+    opening = float(q_wsg[1] - q_wsg[0])
+    contact: ContactResults = plant.get_contact_results_output_port().Eval(plant_context)
+    surfaces = 0
+    inspector = station.scene_graph.model_inspector()
+    object_geometries = set(plant.GetCollisionGeometriesForBody(body))
+    for i in range(contact.num_hydroelastic_contacts()):
+        s = contact.hydroelastic_contact_info(i).contact_surface()
+        if s.id_M() in object_geometries or s.id_N() in object_geometries:
+            surfaces += 1
+    del inspector
+    object_rise = X_WO.translation()[2] - z_obj_grasp
+    gripper_rise = G.CalcPoseInWorld(plant_context).translation()[2] - z_g_grasp
+    held = bool(object_rise > 0.8 * gripper_rise and opening > 0.005)
+    return GraspLiftResult(held, float(object_rise), float(gripper_rise), opening, surfaces,
+                           times[-1], wall, render_time)

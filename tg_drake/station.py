@@ -1,0 +1,288 @@
+"""The simulated station: iiwa 14 + WSG 50, a table, library objects and RGB-D cameras.
+
+    station = add_station(builder, scenario=scenario)   # into your own DiagramBuilder
+    diagram = make_station(scenario)                    # or a standalone diagram with exported ports
+
+Contact is hydroelastic (`MultibodyPlantConfig`, SAP). The arm and the fingers are driven by the
+plant's own PD controllers on their joint actuators (implicit in SAP, which allows a much larger time
+step than an explicit inverse-dynamics loop); the WSG's finger force is limited through the finger
+actuators' effort limits, which SAP respects. Gravity on the arm and gripper is compensated (as the
+KUKA controller does for the arm and its configured payload); gravity acts on everything else.
+
+Cameras are `RgbdSensor`s rendered by `RenderEngineVtk`. A sensor renders only when one of its
+image ports is evaluated, so a stage that needs one image asks once, and the simulation itself never
+renders.
+
+Station ports (as exported by `make_station`; `add_station` returns the same ports by name):
+
+- inputs: ``iiwa.desired_state`` (14: q, v), ``wsg.position`` (1: opening width [m]).
+- outputs: ``iiwa.state`` (14), ``wsg.state`` (4), ``body_poses``, ``contact_results``,
+  ``query_object``, and per camera ``<camera>.rgb_image``, ``<camera>.depth_image``,
+  ``<camera>.label_image``, ``<camera>.camera_pose`` (X_WC, a RigidTransform).
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.resources
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.geometry import MakeRenderEngineVtk, RenderEngineVtkParams, SceneGraph
+from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
+from pydrake.multibody.parsing import (AddModel, ModelDirective, ModelDirectives, Parser,
+                                       ProcessModelDirectives)
+from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.multibody.tree import (JointActuatorIndex, ModelInstanceIndex, PdControllerGains, SpatialInertia,
+                                    UnitInertia)
+from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import MatrixGain
+from pydrake.systems.sensors import CameraInfo, RgbdSensor
+
+from tg_drake.errors import ModelError, ScenarioError
+from tg_drake.scenario import JointPdDriver, ObjectPlacement, Scenario, WsgPdDriver
+
+WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container
+
+
+@functools.cache
+def models_root() -> str:
+    """The folder of the tg_drake_models package (models/ in the source tree)."""
+    return str(importlib.resources.files("tg_drake_models"))
+
+
+def make_parser(plant: MultibodyPlant) -> Parser:
+    """A parser that resolves package://tg_drake_models/... (and nothing from the internet)."""
+    parser = Parser(plant)
+    parser.package_map().AddPackageXml(f"{models_root()}/package.xml")
+    return parser
+
+
+def placement_pose(scenario: Scenario, placement: ObjectPlacement) -> RigidTransform:
+    """X_WO of a placed object: table frame · (xy, yaw on the table) · the library's resting X_TO."""
+    from tg_drake.objects import get_object
+
+    obj = get_object(placement.id)
+    X_TO = obj.resting_pose(placement.pose)
+    X_T_yaw = RigidTransform(RollPitchYaw(0, 0, np.deg2rad(placement.yaw)),
+                             [placement.xy[0], placement.xy[1], 0.0])
+    X_WT = scenario.X_WT.GetDeterministicValue()
+    return X_WT @ X_T_yaw @ RigidTransform(X_TO)
+
+
+@dataclass
+class CameraHandles:
+    sensor: RgbdSensor
+    info: CameraInfo  # intrinsics of the depth camera
+    X_PB: RigidTransform  # sensor body pose in its parent frame (the world)
+    X_BC: RigidTransform  # depth camera in the sensor body
+
+
+@dataclass
+class Station:
+    """What `add_station` added to a builder."""
+
+    scenario: Scenario
+    plant: MultibodyPlant
+    scene_graph: SceneGraph
+    instances: dict[str, ModelInstanceIndex]  # model instance name → index
+    objects: dict[str, ModelInstanceIndex]  # placed library objects: instance name → index
+    cameras: dict[str, CameraHandles]
+    inputs: dict = field(default_factory=dict)  # port name → InputPort
+    outputs: dict = field(default_factory=dict)  # port name → OutputPort
+
+    def object_body(self, name: str):
+        bodies = self.plant.GetBodyIndices(self.objects[name])
+        return self.plant.get_body(bodies[0])
+
+
+class _CameraPose(LeafSystem):
+    """Turns the sensor's body pose X_WB into the depth camera's pose X_WC = X_WB · X_BD."""
+
+    def __init__(self, X_BC: RigidTransform):
+        super().__init__()
+        self._X_BC = X_BC
+        self._X_WB = self.DeclareAbstractInputPort("X_WB", _rigid_transform_value())
+        self.DeclareAbstractOutputPort("X_WC", _rigid_transform_value, self._calc,
+                                       prerequisites_of_calc={self.all_input_ports_ticket()})
+
+    def _calc(self, context, output):
+        output.set_value(self._X_WB.Eval(context) @ self._X_BC)
+
+
+def _rigid_transform_value():
+    from pydrake.common.value import AbstractValue
+    return AbstractValue.Make(RigidTransform())
+
+
+def _actuators(plant: MultibodyPlant, instance: ModelInstanceIndex) -> list:
+    """The joint actuators of a model instance (works before Finalize)."""
+    actuators = [plant.get_joint_actuator(JointActuatorIndex(i))
+                 for i in range(plant.num_actuators())]
+    actuators = [a for a in actuators if a.model_instance() == instance]
+    if not actuators:
+        raise ModelError(f"model '{plant.GetModelInstanceName(instance)}' has no actuated joints")
+    return actuators
+
+
+def _apply_joint_pd(plant: MultibodyPlant, instance: ModelInstanceIndex, kp: float, kd: float):
+    for actuator in _actuators(plant, instance):
+        actuator.set_controller_gains(PdControllerGains(p=kp, d=kd))
+
+
+def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser
+                 ) -> dict[str, ModelInstanceIndex]:
+    if not scenario.objects:
+        return {}
+    from tg_drake.objects import get_object
+
+    directives = [ModelDirective(add_model=AddModel(
+        name=p.instance_name, file=get_object(p.id).package_url)) for p in scenario.objects]
+    added = ProcessModelDirectives(ModelDirectives(directives=directives), parser)
+    objects = {}
+    for placement, info in zip(scenario.objects, added):
+        instance = info.model_instance
+        objects[placement.instance_name] = instance
+        body = plant.get_body(plant.GetBodyIndices(instance)[0])
+        plant.SetDefaultFreeBodyPose(body, placement_pose(scenario, placement))
+        if placement.containment == "full":
+            _add_contents(plant, instance, body, get_object(placement.id))
+    return objects
+
+
+def _add_contents(plant: MultibodyPlant, instance, body, obj) -> None:
+    """A "full" container: water filling its cavity, as a solid cylinder welded inside it."""
+    radius, height, p_OC = obj.cavity_cylinder()
+    mass = WATER_DENSITY * obj.cavity_volume
+    M = SpatialInertia(mass=mass, p_PScm_E=np.zeros(3),
+                       G_SP_E=UnitInertia.SolidCylinder(radius, height, [0, 0, 1]))
+    contents = plant.AddRigidBody(f"{body.name()}_contents", instance, M)
+    plant.WeldFrames(body.body_frame(), contents.body_frame(), RigidTransform(p_OC))
+
+
+def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
+    """Adds the plant, scene graph, drivers and cameras of `scenario` to `builder`."""
+    # Plant and scene graph, hydroelastic contact with SAP.
+    plant, scene_graph = AddMultibodyPlant(scenario.plant_config, builder)
+    parser = make_parser(plant)
+
+    # Robot, gripper, table from the directives; library objects from the `objects` block.
+    try:
+        added = ProcessModelDirectives(ModelDirectives(directives=scenario.directives), parser)
+    except RuntimeError as e:
+        raise ModelError(f"could not load the scenario's directives: {e}") from None
+    instances = {plant.GetModelInstanceName(i.model_instance): i.model_instance for i in added}
+    objects = _add_objects(scenario, plant, parser)
+    instances.update(objects)
+
+    # Drivers: PD control on the joint actuators (desired state enters the plant).
+    for name, driver in scenario.model_drivers.items():
+        if name not in instances:
+            raise ScenarioError(f"model_drivers names '{name}', which the directives do not add; "
+                                f"models: {', '.join(instances)}", field="model_drivers")
+        instance = instances[name]
+        _apply_joint_pd(plant, instance, driver.kp, driver.kd)
+        if isinstance(driver, WsgPdDriver):
+            for actuator in _actuators(plant, instance):
+                actuator.set_effort_limit(driver.force_limit)
+        if isinstance(driver, JointPdDriver) and not driver.gravity_compensation:
+            continue
+        plant.set_gravity_enabled(instance, False)
+    plant.Finalize()
+
+    station = Station(scenario=scenario, plant=plant, scene_graph=scene_graph,
+                      instances=instances, objects=objects, cameras={})
+
+    # Ports of the arm and the gripper.
+    if "iiwa" in instances:
+        station.inputs["iiwa.desired_state"] = plant.get_desired_state_input_port(instances["iiwa"])
+        station.outputs["iiwa.state"] = plant.get_state_output_port(instances["iiwa"])
+    if "wsg" in instances:
+        # Opening width w → finger joint positions (−w/2, +w/2), zero velocities.
+        to_state = builder.AddNamedSystem("wsg_width_to_desired_state",
+                                          MatrixGain(np.array([[-0.5], [0.5], [0.0], [0.0]])))
+        builder.Connect(to_state.get_output_port(),
+                        plant.get_desired_state_input_port(instances["wsg"]))
+        station.inputs["wsg.position"] = to_state.get_input_port()
+        station.outputs["wsg.state"] = plant.get_state_output_port(instances["wsg"])
+    station.outputs["body_poses"] = plant.get_body_poses_output_port()
+    station.outputs["contact_results"] = plant.get_contact_results_output_port()
+    station.outputs["query_object"] = scene_graph.get_query_output_port()
+
+    # Cameras: RgbdSensors rendered with VTK, which render only when asked.
+    if scenario.cameras:
+        scene_graph.AddRenderer("vtk", MakeRenderEngineVtk(RenderEngineVtkParams()))
+    for name, config in scenario.cameras.items():
+        color_camera, depth_camera = config.MakeCameras()
+        color_camera = _with_renderer(color_camera, "vtk")
+        depth_camera = _with_renderer_depth(depth_camera, "vtk")
+        X_PB = config.X_PB.GetDeterministicValue()
+        parent = scene_graph.world_frame_id()
+        if config.X_PB.base_frame and config.X_PB.base_frame != "world":
+            parent = plant.GetBodyFrameIdOrThrow(
+                plant.GetFrameByName(config.X_PB.base_frame).body().index())
+        sensor = builder.AddNamedSystem(
+            f"rgbd_sensor_{name}", RgbdSensor(parent_id=parent, X_PB=X_PB,
+                                              color_camera=color_camera,
+                                              depth_camera=depth_camera))
+        builder.Connect(scene_graph.get_query_output_port(), sensor.query_object_input_port())
+        X_BC = depth_camera.core().sensor_pose_in_camera_body()
+        pose = builder.AddNamedSystem(f"camera_pose_{name}", _CameraPose(X_BC))
+        builder.Connect(sensor.body_pose_in_world_output_port(), pose.get_input_port())
+        station.cameras[name] = CameraHandles(sensor=sensor,
+                                              info=depth_camera.core().intrinsics(),
+                                              X_PB=X_PB, X_BC=X_BC)
+        station.outputs[f"{name}.rgb_image"] = sensor.color_image_output_port()
+        station.outputs[f"{name}.depth_image"] = sensor.depth_image_32F_output_port()
+        station.outputs[f"{name}.label_image"] = sensor.label_image_output_port()
+        station.outputs[f"{name}.camera_pose"] = pose.get_output_port()
+    return station
+
+
+def _with_renderer(color_camera, renderer_name: str):
+    from pydrake.geometry import ColorRenderCamera, RenderCameraCore
+    core = color_camera.core()
+    return ColorRenderCamera(
+        RenderCameraCore(renderer_name, core.intrinsics(), core.clipping(),
+                         core.sensor_pose_in_camera_body()), color_camera.show_window())
+
+
+def _with_renderer_depth(depth_camera, renderer_name: str):
+    from pydrake.geometry import DepthRenderCamera, RenderCameraCore
+    core = depth_camera.core()
+    return DepthRenderCamera(
+        RenderCameraCore(renderer_name, core.intrinsics(), core.clipping(),
+                         core.sensor_pose_in_camera_body()), depth_camera.depth_range())
+
+
+def make_station(scenario: Scenario) -> tuple[Diagram, Station]:
+    """A standalone station diagram with every station port exported under its name."""
+    builder = DiagramBuilder()
+    station = add_station(builder, scenario=scenario)
+    for name, port in station.inputs.items():
+        builder.ExportInput(port, name)
+    for name, port in station.outputs.items():
+        builder.ExportOutput(port, name)
+    diagram = builder.Build()
+    diagram.set_name("station")
+    return diagram, station
+
+
+def flange_pose(plant: MultibodyPlant, plant_context) -> RigidTransform:
+    """X_W7: pose of the iiwa's link 7 (the flange is 0.045 m further along its z)."""
+    return plant.GetFrameByName("iiwa_link_7").CalcPoseInWorld(plant_context)
+
+
+def gripper_pose(plant: MultibodyPlant, plant_context) -> RigidTransform:
+    """X_WG: pose of the WSG body frame G."""
+    return plant.GetFrameByName("body", plant.GetModelInstanceByName("wsg")).CalcPoseInWorld(
+        plant_context)
+
+
+def rotation_from_axes(x_W, y_W) -> RotationMatrix:
+    """A rotation whose x and y axes are (the orthonormalised) x_W and y_W."""
+    x = np.asarray(x_W, float)
+    x = x / np.linalg.norm(x)
+    y = np.asarray(y_W, float) - x * np.dot(x, y_W)
+    y = y / np.linalg.norm(y)
+    return RotationMatrix(np.column_stack([x, y, np.cross(x, y)]))
