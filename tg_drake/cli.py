@@ -2,7 +2,8 @@
 
 Each subcommand lives in the module that owns its work; this file only dispatches. A module listed
 in COMMANDS provides `add_arguments(parser)` and `main(args) -> int` and a one-line `HELP`.
-Modules are imported only when their command runs, so `tg-drake objects` never loads ProbLog.
+Command modules keep their heavy imports (pydrake, ProbLog, Open3D) inside functions, so building
+the parser stays cheap.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from tg_drake.errors import TgDrakeError
 # command name → module implementing it.
 COMMANDS: dict[str, str] = {
     "bench": "tg_drake.bench",
+    "render": "tg_drake.render",
 }
 
 
