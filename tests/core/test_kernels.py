@@ -311,3 +311,27 @@ def test_resampling_follows_a_moved_cloud(raw_clouds):
     shift = np.broadcast_to([0.5037, -0.2011, 0.7993], a.points.shape)
     # 1e-15 m: float rounding of the shifted coordinates.
     np.testing.assert_allclose(b.points - a.points, shift, rtol=0, atol=1e-15)
+
+
+def test_leave_one_object_out_drops_all_samplings_of_the_held_out_object():
+    from tg_drake.kernels.evaluation import best, leave_one_object_out, random_score
+
+    # Graphs 0, 1 are two samplings of object "a" (category 0); "b" is category 1, "c" 0.
+    k = np.array([[1.0, 0.99, 0.9, 0.5],
+                  [0.99, 1.0, 0.4, 0.8],
+                  [0.9, 0.4, 1.0, 0.3],
+                  [0.5, 0.8, 0.3, 1.0]])
+    scores = leave_one_object_out(np.stack([k, k[[0, 1, 3, 2]][:, [0, 1, 3, 2]]]),
+                                  ["a", "a", "b", "c"], [0, 0, 1, 0], n_neighbours=10)
+    # T = 0: graph 0 sees b (0.9) before c (0.5): wrong, rank 2; graph 1 sees c first: right,
+    # rank 1; b sees only category 0: wrong, and its category ties with the nine others at 0
+    # for ranks 2..11, mean 6.5; c sees a first: right, rank 1.
+    assert scores[0].accuracy == 0.5
+    assert scores[0].mean_rank == (2 + 1 + 6.5 + 1) / 4
+    # T = 1 swaps the kernel entries of b and c: graph 0 now sees c (0.9) first: right, rank 1;
+    # graph 1 sees b (0.8) first: wrong, rank 2; b sees only category 0: rank 6.5; c right.
+    assert (scores[1].accuracy, scores[1].mean_rank) == (0.5, (1 + 2 + 6.5 + 1) / 4)
+    # Equal scores: the smaller T wins.
+    assert best(scores).T == 0 and best(scores, by="mean_rank").T == 0
+    assert random_score().accuracy == pytest.approx(1 / 11)
+    assert random_score().mean_rank == 6.0
