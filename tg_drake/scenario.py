@@ -12,7 +12,6 @@ frame T has its origin at the centre of the table-top surface, z up. Objects are
 library id, a pose label, a position on the table (in T) and a yaw about the table normal.
 """
 
-from __future__ import annotations
 
 import dataclasses
 import math
@@ -21,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import yaml
 from pydrake.common.schema import Transform
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.math import RigidTransform, RollPitchYaw
@@ -198,7 +198,7 @@ class Scenario:
                            field="task.target")
 
 
-def load_scenario(filename: str | Path | None = None, *, scenario_name: str | None = None,
+def load_scenario(filename: "str | Path | None" = None, *, scenario_name: str | None = None,
                   scenario_text: str | None = None) -> Scenario:
     """Loads a scenario: the file (or one named entry of it), then `scenario_text` layered on top.
 
@@ -215,7 +215,7 @@ def load_scenario(filename: str | Path | None = None, *, scenario_name: str | No
                                        child_name=scenario_name, defaults=scenario)
         if scenario_text:
             scenario = yaml_load_typed(schema=Scenario, data=scenario_text, defaults=scenario)
-    except (RuntimeError, ValueError, TypeError, KeyError) as e:
+    except (RuntimeError, ValueError, TypeError, KeyError, AssertionError, yaml.YAMLError) as e:
         raise ScenarioError(_tidy_yaml_error(str(e)), file=where) from None
     validate(scenario, where=where)
     return scenario
@@ -223,7 +223,6 @@ def load_scenario(filename: str | Path | None = None, *, scenario_name: str | No
 
 def scenario_names(filename: str | Path) -> list[str]:
     """The named entries of a multi-scenario file (its top-level keys that are mappings)."""
-    import yaml
     with open(filename) as f:
         data = yaml.safe_load(f) or {}
     schema_keys = {f.name for f in dataclasses.fields(Scenario)}
@@ -237,8 +236,6 @@ def _tidy_yaml_error(message: str) -> str:
 
 def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
     """Checks names and geometry that YAML typing alone cannot."""
-    from tg_drake.objects import get_object  # the library is loaded only when objects are named
-
     names = set()
     half = np.asarray(scenario.table_size) / 2
     for i, placement in enumerate(scenario.objects):
@@ -246,6 +243,8 @@ def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
         if not placement.id:
             raise ScenarioError("an object needs an `id` (see `tg-drake objects`)", file=where,
                                 field=f + ".id")
+        from tg_drake.objects import get_object  # the library loads only when objects are named
+
         try:
             obj = get_object(placement.id)
         except ScenarioError as e:
