@@ -1,0 +1,75 @@
+"""What physically happened to the target object: grasped, lifted, placed — read off the plant.
+
+These checks read the simulated state (poses, finger positions, hydroelastic contact surfaces); they
+are the ground truth of an execution, never inputs to the pipeline's decisions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+# A finger opening below this means the fingers closed on air (the pads' compliance squeezes a
+# held object by at most a few millimetres) [m].
+CLOSED_ON_AIR = 0.004
+# Placement tolerances: distance of the object's centre from the place target on the table [m],
+# tilt of its axis from the pose it was picked in [rad].
+PLACE_XY_TOLERANCE = 0.05
+PLACE_TILT_TOLERANCE = np.deg2rad(20)
+
+
+@dataclass
+class HandContact:
+    opening: float  # [m] distance between the finger pads' inner faces
+    left: bool  # the left pad touches the object
+    right: bool  # the right pad touches the object
+    hydroelastic: int  # hydroelastic contact surfaces on the object
+
+    @property
+    def held(self) -> bool:
+        return self.left and self.right and self.opening > CLOSED_ON_AIR
+
+
+def hand_contact(plant, plant_context, *, object_body, wsg_instance) -> HandContact:
+    """Which finger pads touch the object, from the plant's contact results."""
+    q = plant.GetPositions(plant_context, wsg_instance)
+    results = plant.get_contact_results_output_port().Eval(plant_context)
+    object_geometries = set(plant.GetCollisionGeometriesForBody(object_body))
+    left = set(plant.GetCollisionGeometriesForBody(
+        plant.GetBodyByName("left_finger", wsg_instance)))
+    right = set(plant.GetCollisionGeometriesForBody(
+        plant.GetBodyByName("right_finger", wsg_instance)))
+    touches_left = touches_right = False
+    surfaces = 0
+    pairs = []
+    for i in range(results.num_hydroelastic_contacts()):
+        s = results.hydroelastic_contact_info(i).contact_surface()
+        pairs.append((s.id_M(), s.id_N()))
+        if s.id_M() in object_geometries or s.id_N() in object_geometries:
+            surfaces += 1
+    for i in range(results.num_point_pair_contacts()):
+        info = results.point_pair_contact_info(i).point_pair()
+        pairs.append((info.id_A, info.id_B))
+    for a, b in pairs:
+        other = b if a in object_geometries else a if b in object_geometries else None
+        if other is None:
+            continue
+        touches_left |= other in left
+        touches_right |= other in right
+    return HandContact(float(q[1] - q[0]), touches_left, touches_right, surfaces)
+
+
+def placed(X_WO_picked, X_WO_now, p_W_target_xy, *, released: bool) -> tuple[bool, str]:
+    """Is the object standing at the place target, in the pose it was picked in, and let go?"""
+    xy_error = float(np.linalg.norm(X_WO_now.translation()[:2] - np.asarray(p_W_target_xy)))
+    z_before = X_WO_picked.rotation().col(2)
+    z_now = X_WO_now.rotation().col(2)
+    tilt = float(np.arccos(np.clip(np.dot(z_before, z_now), -1.0, 1.0)))
+    if not released:
+        return False, "still in the hand"
+    if xy_error > PLACE_XY_TOLERANCE:
+        return False, f"{xy_error * 100:.1f} cm from the place target"
+    if tilt > PLACE_TILT_TOLERANCE:
+        return False, f"tipped over ({np.rad2deg(tilt):.0f}° from its picked pose)"
+    return True, f"{xy_error * 100:.1f} cm from the target, tilted {np.rad2deg(tilt):.0f}°"
