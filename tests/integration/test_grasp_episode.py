@@ -1,0 +1,85 @@
+"""One grasp in hydroelastic physics: the free-floating WSG 50 closes, lifts and shakes.
+
+The object is the cylinder of robot_facts.md (r 0.033 m, h 0.1 m, 0.3 kg), rigid hydroelastic with
+friction 1.0, standing upright on the table.
+"""
+
+import numpy as np
+import pytest
+
+from tg_drake.grasping.dgi import FINGERTIP_Y, PAD_CENTER_Y
+from tg_drake.grasping.episode import EpisodeConfig, GraspWorld
+
+CYLINDER_SDF = """<?xml version="1.0"?>
+<sdf version="1.9" xmlns:drake="http://drake.mit.edu">
+  <model name="cylinder">
+    <link name="cylinder">
+      <inertial><mass>0.3</mass>
+        <inertia><ixx>3.32e-4</ixx><iyy>3.32e-4</iyy><izz>1.63e-4</izz>
+          <ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>
+      <collision name="collision">
+        <geometry><cylinder><radius>0.033</radius><length>0.1</length></cylinder></geometry>
+        <drake:proximity_properties><drake:rigid_hydroelastic/>
+          <drake:mesh_resolution_hint>0.01</drake:mesh_resolution_hint>
+          <drake:mu_dynamic>1.0</drake:mu_dynamic><drake:mu_static>1.0</drake:mu_static>
+        </drake:proximity_properties>
+      </collision>
+    </link>
+  </model>
+</sdf>
+"""
+
+HEIGHT = 0.1
+X_WO = np.eye(4)
+X_WO[2, 3] = HEIGHT / 2  # standing on the table top (z_W = 0)
+
+
+def top_down(grasp_point):
+    """Approach −z_W, fingers closing along x_W."""
+    X = np.eye(4)
+    X[:3, :3] = np.column_stack([[1, 0, 0], [0, 0, -1], [0, 1, 0]])
+    X[:3, 3] = np.asarray(grasp_point) + [0, 0, PAD_CENTER_Y]
+    return X
+
+
+@pytest.fixture(scope="module")
+def world(tmp_path_factory):
+    path = tmp_path_factory.mktemp("objects") / "cylinder.sdf"
+    path.write_text(CYLINDER_SDF)
+    return GraspWorld(str(path), EpisodeConfig())
+
+
+def test_a_centred_grasp_holds_through_lift_and_shake(world):
+    # Pads reach 0.096 − 0.055 = 41 mm below the grasp point: 31 mm below the cylinder's top.
+    result = world.run(X_WO, top_down([0, 0, HEIGHT + 0.01]))
+    assert result["status"] == "ok" and result["success"]
+    # The fingers stop on the 66 mm wide cylinder; pressed with 60 N each, the compliant pads
+    # (1e6 Pa, 12 mm thick) overlap it by a few mm each (3 mm here): allow up to 5.5 mm each.
+    assert 0.055 < result["finger_gap"] < 0.066
+    # 10 mm: the object may slip a little in the pads while it is lifted 0.1 m and shaken.
+    assert result["object_rise"] == pytest.approx(0.1, abs=0.01)
+
+
+def test_a_grasp_beside_the_object_closes_on_nothing(world):
+    result = world.run(X_WO, top_down([0.09, 0, HEIGHT + 0.01]))
+    assert result["status"] == "ok" and not result["success"]
+    assert result["finger_gap"] < 0.002  # fully closed
+    assert abs(result["object_rise"]) < 0.005  # the cylinder still stands on the table
+
+
+def test_a_grasp_on_the_rim_with_the_fingertips_slips(world):
+    # Only the last 2 mm of the pads reach the cylinder's top edge.
+    result = world.run(X_WO, top_down([0, 0, HEIGHT + (FINGERTIP_Y - PAD_CENTER_Y) - 0.002]))
+    assert result["status"] == "ok" and not result["success"]
+
+
+def test_a_physics_failure_is_reported_not_raised(world):
+    # The object placed inside the table top: it is pushed out or falls through, never raises.
+    X = X_WO.copy()
+    X[2, 3] = -0.3
+    result = world.run(X, top_down([0, 0, HEIGHT + 0.01]))
+    assert result["status"] == "sim_error"
+    assert result["reason"] == "object fell through the table during approach"
+    # The world is reusable after a failure.
+    again = world.run(X_WO, top_down([0, 0, HEIGHT + 0.01]))
+    assert again["status"] == "ok" and again["success"]
