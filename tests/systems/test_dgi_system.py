@@ -1,0 +1,137 @@
+"""DgiScoringSystem alone: fixed scene description and grasp semantics in, ranked grasps out."""
+
+import numpy as np
+import pytest
+from pydrake.systems.framework import DiagramBuilder
+
+from tg_drake.errors import GraspingError
+from tg_drake.grasping.dgi import GRIPPER_BASE_Y, PAD_CENTER_Y, dgi_features
+from tg_drake.grasping.model import DgiGraspModel, load_model
+from tg_drake.grasping.svm import PlattSvmClassifier
+from tg_drake.systems.dgi_system import DgiScoringSystem
+from tg_drake.types import (
+    GraspCandidates,
+    GraspSemantics,
+    ObjectDescription,
+    SceneDescription,
+    part_index,
+)
+
+
+def synthetic_training_set(rng, n=300):
+    """Cylinders that fit between the fingers (1) against empty volumes and plates wider than the
+    opening (0), seen from the gripper frame."""
+    x = np.arange(-0.07, 0.07, 0.001)
+    z = np.arange(-0.012, 0.012, 0.002)
+    xx, zz = (a.ravel() for a in np.meshgrid(x, z, indexing="ij"))
+    features, labels = [], []
+    for i in range(n):
+        depth = rng.uniform(0.005, 0.04)
+        if i % 3 == 0:
+            r = rng.uniform(0.015, 0.045)
+            keep = np.abs(xx) < r
+            d, xs, zs = depth + r - np.sqrt(r**2 - xx[keep] ** 2), xx[keep], zz[keep]
+        elif i % 3 == 1:
+            d, xs, zs = np.full(xx.shape, depth), xx, zz
+        else:
+            d, xs, zs = np.full(1, depth), np.full(1, 1.0), np.zeros(1)  # nothing in the volume
+        p_G = np.stack([xs, GRIPPER_BASE_Y + d, zs], axis=1)
+        features.append(dgi_features(p_G, np.eye(4))[0])
+        labels.append(int(i % 3 == 0))
+    return np.array(features), np.array(labels)
+
+
+@pytest.fixture(scope="module")
+def model():
+    X, y = synthetic_training_set(np.random.default_rng(0))
+    return DgiGraspModel(PlattSvmClassifier(gamma=1.0, random_state=0).fit(X, y))
+
+
+def top_down(grasp_point):
+    X = np.eye(4)
+    X[:3, :3] = np.column_stack([[1, 0, 0], [0, 0, -1], [0, 1, 0]])
+    X[:3, 3] = np.asarray(grasp_point) + [0, 0, PAD_CENTER_Y]
+    return X
+
+
+def cylinder_object(pregrasps, parts):
+    """An upright cylinder (r 0.03 m, h 0.1 m) on the table at x = 0.5 m."""
+    t = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    h = np.linspace(0, 0.1, 51)
+    tt, hh = (a.ravel() for a in np.meshgrid(t, h))
+    p = np.stack([0.5 + 0.03 * np.cos(tt), 0.03 * np.sin(tt), hh], axis=1)
+    n = np.stack([np.cos(tt), np.sin(tt), np.zeros_like(tt)], axis=1)
+    X_WO = np.eye(4)
+    X_WO[:3, 3] = [0.5, 0, 0.05]
+    return ObjectDescription(
+        p_W=p, n_W=n, labels=np.zeros(len(p), int), visible=np.ones(len(p), bool), X_WO=X_WO,
+        extents=np.array([0.06, 0.06, 0.1]), pose="upright", pose_likelihood={"upright": 1.0},
+        part_probabilities={"top": 1.0, "middle": 1.0}, part_boxes={},
+        pregrasp_X_WG=np.asarray(pregrasps), pregrasp_parts=np.asarray(parts))
+
+
+@pytest.fixture
+def setup(model):
+    builder = DiagramBuilder()
+    system = builder.AddSystem(DgiScoringSystem(model))
+    diagram = builder.Build()
+    return system, diagram
+
+
+def evaluate(system, diagram, scene, semantics) -> GraspCandidates:
+    context = diagram.CreateDefaultContext()
+    sub = system.GetMyMutableContextFromRoot(context)
+    system.get_scene_description_input_port().FixValue(sub, scene)
+    system.get_grasp_semantics_input_port().FixValue(sub, semantics)
+    return system.get_ranked_grasps_output_port().Eval(sub)
+
+
+def test_ranks_the_targets_hypotheses_by_part_and_local_shape(setup, model):
+    system, diagram = setup
+    poses = np.stack([
+        top_down([0.5, 0, 0.09]),  # on the cylinder's top: graspable
+        top_down([0.62, 0, 0.09]),  # beside it: nothing between the fingers
+        top_down([0.5, 0, 0.07]),  # on the cylinder, a part the logic gives 0.3
+        top_down([0.5, 0, 0.09]),  # graspable, but a part the logic does not name
+    ])
+    parts = [part_index("top"), part_index("top"), part_index("middle"), part_index("handle")]
+    target = cylinder_object(poses, parts)
+    other = cylinder_object(poses[:1], parts[:1])
+    scene = SceneDescription(objects=[other, target], X_WT=np.eye(4), target=1)
+    semantics = GraspSemantics(category={"cup": 1.0}, task={"pass": 1.0},
+                               part={"top": 0.7, "middle": 0.3}, given_task="pass", target=1)
+
+    ranked = evaluate(system, diagram, scene, semantics)
+    p_local = model.p_grasp(target.p_W, poses)
+    assert p_local[0] > 0.5 > p_local[1]  # the model separates the two shapes
+    order = np.argsort(-(np.array([0.7, 0.7, 0.3, 0.0]) * p_local), kind="stable")
+    assert ranked.target == 1
+    np.testing.assert_array_equal(ranked.parts, np.asarray(parts)[order])
+    # 1e-12: the same arithmetic as the system's.
+    np.testing.assert_allclose(ranked.p_local, p_local[order], atol=1e-12)
+    np.testing.assert_allclose(ranked.p_part, np.array([0.7, 0.7, 0.3, 0.0])[order])
+    np.testing.assert_allclose(ranked.score, ranked.p_part * ranked.p_local, atol=1e-15)
+    np.testing.assert_array_equal(ranked.X_WG, poses[order])
+    assert np.all(np.diff(ranked.score) <= 0)
+    assert ranked.parts[0] == part_index("top") and ranked.score[-1] == 0.0
+
+
+def test_a_target_outside_the_scene_is_a_clear_error(setup):
+    system, diagram = setup
+    scene = SceneDescription(objects=[cylinder_object(np.zeros((0, 4, 4)), [])], X_WT=np.eye(4))
+    semantics = GraspSemantics(category={}, task={}, part={}, given_task=None, target=2)
+    with pytest.raises(GraspingError, match="target object 2 but the scene description has 1"):
+        evaluate(system, diagram, scene, semantics)
+    semantics.target = 0
+    assert len(evaluate(system, diagram, scene, semantics).score) == 0
+
+
+def test_model_file_round_trip(model, tmp_path):
+    path = tmp_path / "m.joblib"
+    model.save(path)
+    loaded = load_model(path)
+    X, _ = synthetic_training_set(np.random.default_rng(1), 30)
+    np.testing.assert_array_equal(loaded.classifier.predict_proba(X),
+                                  model.classifier.predict_proba(X))
+    with pytest.raises(GraspingError, match="no DGI model file"):
+        load_model(tmp_path / "missing.joblib")

@@ -1,0 +1,43 @@
+"""The final grasp score: the logic's P(part | task) times the DGI model's P(grasp | local shape)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tg_drake.errors import GraspingError
+from tg_drake.grasping.model import DgiGraspModel
+from tg_drake.types import PART_LABELS, GraspCandidates, GraspSemantics, SceneDescription
+
+
+def rank_grasps(scene: SceneDescription, semantics: GraspSemantics,
+                model: DgiGraspModel) -> GraspCandidates:
+    """Every pre-grasp hypothesis of the target object, scored and sorted best first.
+
+    p_local = P(grasp | local shape) from the DGI model, p_part = the logic's P(part | task) of the
+    hypothesis' part (0 for a part the logic did not name), score = p_part · p_local. Ties keep the
+    hypotheses' order.
+    """
+    target = semantics.target
+    if not 0 <= target < len(scene.objects):
+        raise GraspingError(
+            f"grasp_semantics names target object {target} but the scene description has "
+            f"{len(scene.objects)} object(s)")
+    obj = scene.objects[target]
+    X_WG = np.asarray(obj.pregrasp_X_WG, dtype=float).reshape(-1, 4, 4)
+    parts = np.asarray(obj.pregrasp_parts, dtype=int).reshape(-1)
+    if len(parts) != len(X_WG):
+        raise GraspingError(
+            f"object {target} has {len(X_WG)} pre-grasp poses but {len(parts)} part labels")
+    if np.any((parts < 0) | (parts >= len(PART_LABELS))):
+        raise GraspingError(
+            f"pre-grasp part labels must index PART_LABELS (0..{len(PART_LABELS) - 1}), got "
+            f"{sorted(set(parts.tolist()))}")
+    if len(X_WG) == 0:
+        empty = np.zeros(0)
+        return GraspCandidates(np.zeros((0, 4, 4)), parts, empty, empty, empty, target)
+    p_local = model.p_grasp(obj.p_W, X_WG)
+    p_part = np.array([semantics.part.get(PART_LABELS[k], 0.0) for k in parts], dtype=float)
+    score = p_part * p_local
+    order = np.argsort(-score, kind="stable")
+    return GraspCandidates(X_WG[order], parts[order], p_part[order], p_local[order], score[order],
+                           target)
