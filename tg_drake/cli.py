@@ -17,6 +17,7 @@ from tg_drake.errors import TgDrakeError
 # command name → module implementing it.
 COMMANDS: dict[str, str] = {
     "bench": "tg_drake.bench",
+    "objects": "tg_drake.objects",
     "render": "tg_drake.render",
 }
 

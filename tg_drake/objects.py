@@ -1,0 +1,286 @@
+"""The object library: 44 generated household objects of the paper's 11 categories.
+
+Files live in the `tg_drake_models` package (``models/objects/<id>/``): ``<id>.obj`` (the visual and
+collision mesh: closed, outward-oriented triangles), ``<id>.sdf`` (one model and one body with
+mass properties from the mesh volume and material densities, rigid-hydroelastic collision),
+``<id>_parts.npy`` (uint8 part label per mesh vertex, an index into PART_LABELS) and one
+``library.yaml`` describing every object. They are written by ``tools/make_objects.py``.
+
+Object frame O:
+
+- containers (pan, pot, cup, glass, bowl, bottle, can): origin at the centre of the bottom, z along the
+  symmetry axis towards the opening (or neck), handles towards +x;
+- tools (hammer, knife, screwdriver, cooking_tool): x along the long axis from the handle towards
+  the usable area, z normal to the face the tool lies on (up when lying flat), origin at the centre
+  of the bottom face of the bounding box.
+
+Part ground truth: containers are cut in thirds along z — bottom, middle, top (top is the open or
+neck end) — plus the handle; tools have a handle and a usable area (head, blade, shaft and tip,
+spatula head or ladle bowl).
+
+Each object lists the poses that suit it (upright / sideways / upsidedown; tools only "sideways",
+lying flat) with its resting transform X_TO (table-top frame T → object frame O): the object then
+rests on z = 0 of T with its origin above T's origin.
+
+    tg-drake objects            # a table: id, category, size, mass, parts
+    tg-drake objects --json
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.resources
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from types import MappingProxyType
+
+import numpy as np
+import yaml
+
+from tg_drake.errors import ModelError, ScenarioError, unknown_name
+from tg_drake.types import CATEGORIES, PART_LABELS, POSES
+
+HELP = "list the object library (id, category, size, mass, parts)"
+
+PACKAGE = "tg_drake_models"
+
+
+@dataclass(frozen=True)
+class RestingPose:
+    """How an object rests on a table in one pose: X_TO as xyz [m] + roll-pitch-yaw [rad]."""
+
+    pose: str  # an entry of POSES.
+    xyz: tuple[float, float, float]
+    rpy: tuple[float, float, float]  # Drake's RollPitchYaw: R = Rz(yaw)·Ry(pitch)·Rx(roll).
+    support_margin: float  # [m] how far the COM projects inside the support polygon.
+
+    @property
+    def X_TO(self) -> np.ndarray:
+        """4×4 pose of the object frame O in the table-top frame T."""
+        r, p, y = self.rpy
+        cr, sr, cp, sp, cy, sy = (math.cos(r), math.sin(r), math.cos(p), math.sin(p),
+                                  math.cos(y), math.sin(y))
+        X = np.eye(4)
+        X[:3, :3] = [[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]]
+        X[:3, 3] = self.xyz
+        return X
+
+
+@dataclass(frozen=True)
+class LibraryObject:
+    """One object of the library (fields as in library.yaml; SI units)."""
+
+    id: str
+    category: str  # an entry of CATEGORIES.
+    material: str  # main material (the body; for a tool, its usable area).
+    density: float  # [kg/m³] mass / volume (the material's density when the object has one).
+    part_materials: dict  # part name → material, for parts of another material.
+    mass: float  # [kg]
+    volume: float  # [m³] volume of material (a closed bottle's or can's cavity excluded).
+    cavity_volume: float | None  # [m³] containers: water volume when "full"; None otherwise.
+    com: tuple[float, float, float]  # [m] centre of mass in O.
+    inertia: np.ndarray  # (3, 3) [kg·m²] about the centre of mass, O's axes.
+    extents: tuple[float, float, float]  # [m] bounding-box side lengths along O's x, y, z.
+    dimensions: dict  # category-specific sizes [m]: height, diameter, handle_length, ...
+    parts: tuple[str, ...]  # part names present, in PART_LABELS order.
+    grasp_widths: dict  # part → [m] smallest width across the part (open container top: rim wall).
+    poses: dict  # pose name → RestingPose, for the poses that suit the object.
+    n_vertices: int
+    n_triangles: int
+
+    @property
+    def is_tool(self) -> bool:
+        return "usable_area" in self.parts
+
+    @property
+    def is_container(self) -> bool:
+        return self.cavity_volume is not None
+
+    @property
+    def directory(self) -> Path:
+        return Path(str(importlib.resources.files(PACKAGE))) / "objects" / self.id
+
+    @property
+    def sdf_path(self) -> Path:
+        return self.directory / f"{self.id}.sdf"
+
+    @property
+    def mesh_path(self) -> Path:
+        return self.directory / f"{self.id}.obj"
+
+    @property
+    def parts_path(self) -> Path:
+        return self.directory / f"{self.id}_parts.npy"
+
+    @property
+    def sdf_url(self) -> str:
+        """package:// URL of the SDF (Drake resolves it through models/package.xml)."""
+        return f"package://{PACKAGE}/objects/{self.id}/{self.id}.sdf"
+
+    @property
+    def mesh_url(self) -> str:
+        return f"package://{PACKAGE}/objects/{self.id}/{self.id}.obj"
+
+    def resting_pose(self, pose: str) -> RestingPose:
+        """The resting transform for `pose`; ScenarioError naming the poses that suit the object."""
+        if pose not in self.poses:
+            if pose not in POSES:
+                raise unknown_name("pose", pose, POSES, error=ScenarioError)
+            raise ScenarioError(f"pose {pose!r} does not suit {self.id} ({self.category}); "
+                                f"allowed: {', '.join(self.poses)}")
+        return self.poses[pose]
+
+
+def library_path() -> Path:
+    return Path(str(importlib.resources.files(PACKAGE))) / "objects" / "library.yaml"
+
+
+def _object(obj_id: str, d: dict) -> LibraryObject:
+    iu = np.triu_indices(3)
+    inertia = np.zeros((3, 3))
+    inertia[iu] = d["inertia"]
+    inertia = inertia + np.triu(inertia, 1).T
+    inertia.setflags(write=False)
+    poses = {p: RestingPose(p, tuple(v["xyz"]), tuple(v["rpy"]), v["support_margin"])
+             for p, v in d["poses"].items()}
+    return LibraryObject(
+        id=obj_id, category=d["category"], material=d["material"], density=d["density"],
+        part_materials=MappingProxyType(dict(d["part_materials"])), mass=d["mass"],
+        volume=d["volume"], cavity_volume=d["cavity_volume"], com=tuple(d["com"]),
+        inertia=inertia, extents=tuple(d["extents"]),
+        dimensions=MappingProxyType(dict(d["dimensions"])),
+        parts=tuple(p for p in PART_LABELS if p in d["parts"]),
+        grasp_widths=MappingProxyType(dict(d["grasp_widths"])),
+        poses=MappingProxyType(poses), n_vertices=d["n_vertices"], n_triangles=d["n_triangles"])
+
+
+@functools.cache
+def load_library() -> MappingProxyType:
+    """Object id → LibraryObject, in library order (by category, then instance). Cached."""
+    path = library_path()
+    if not path.is_file():
+        raise ModelError("object library missing; run `python tools/make_objects.py`",
+                         file=str(path))
+    with open(path) as f:
+        data = yaml.safe_load(f)
+    try:
+        objects = {k: _object(k, v) for k, v in data["objects"].items()}
+    except (KeyError, TypeError) as e:
+        raise ModelError(f"malformed object library entry: {e}", file=str(path)) from None
+    for o in objects.values():
+        if o.category not in CATEGORIES:
+            raise unknown_name("category", o.category, CATEGORIES, error=ModelError,
+                               file=str(path), field=f"objects.{o.id}.category")
+    return MappingProxyType(objects)
+
+
+def get_object(obj_id: str) -> LibraryObject:
+    """The library object `obj_id`; ScenarioError listing the valid ids when unknown."""
+    lib = load_library()
+    if obj_id not in lib:
+        raise unknown_name("object", obj_id, lib, error=ScenarioError)
+    return lib[obj_id]
+
+
+def library_by_category() -> dict[str, tuple[LibraryObject, ...]]:
+    """Category → its objects, for every entry of CATEGORIES (in that order)."""
+    lib = load_library().values()
+    return {c: tuple(o for o in lib if o.category == c) for c in CATEGORIES}
+
+
+def _as_object(obj: LibraryObject | str) -> LibraryObject:
+    return get_object(obj) if isinstance(obj, str) else obj
+
+
+@functools.cache
+def _mesh(obj_id: str):
+    o = get_object(obj_id)
+    try:
+        text = o.mesh_path.read_text()
+        labels = np.load(o.parts_path)
+    except OSError as e:
+        raise ModelError(f"cannot read {obj_id}'s mesh: {e}", file=str(o.directory)) from None
+    lines = text.splitlines()
+    V = np.array([ln.split()[1:4] for ln in lines if ln.startswith("v ")], float)
+    F = np.array([ln.split()[1:4] for ln in lines if ln.startswith("f ")], np.int64) - 1
+    if len(labels) != len(V) or F.min() < 0 or F.max() >= len(V):
+        raise ModelError(f"{obj_id}: {len(V)} vertices, {len(labels)} part labels, face indices "
+                         f"{F.min()}..{F.max()}", file=str(o.mesh_path))
+    for a in (V, F, labels):
+        a.setflags(write=False)
+    return V, F, labels
+
+
+def mesh(obj: LibraryObject | str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertices (V, 3) [m] in O, triangles (F, 3) int, part label per vertex (V,) uint8).
+
+    Read-only arrays, cached. Triangles are anticlockwise seen from outside (outward normals).
+    """
+    return _mesh(_as_object(obj).id)
+
+
+def sample_surface(obj: LibraryObject | str, *, n: int | None = None,
+                   spacing: float | None = None, rng: np.random.Generator):
+    """Points uniformly distributed on the object's surface (the paper's S_SYN point clouds).
+
+    Give either `n` points or a `spacing` [m]: then n = surface area / spacing², so the number of
+    points grows with the object's size. Triangles are drawn in proportion to their area and points
+    uniformly inside them. Returns (p_O (n, 3) [m], n_O (n, 3) outward unit normals, labels (n,)
+    int part labels: that of the triangle's vertex nearest to the point).
+    """
+    if (n is None) == (spacing is None):
+        raise ValueError("give exactly one of n and spacing")
+    V, F, L = mesh(obj)
+    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    cross = np.cross(b - a, c - a)
+    area2 = np.linalg.norm(cross, axis=1)
+    if spacing is not None:
+        if not spacing > 0:
+            raise ValueError(f"spacing must be positive, got {spacing}")
+        n = max(1, int(round(0.5 * area2.sum() / spacing ** 2)))
+    if n < 1:
+        raise ValueError(f"n must be at least 1, got {n}")
+    tri = rng.choice(len(F), size=n, p=area2 / area2.sum())
+    r1, r2 = rng.random(n), rng.random(n)
+    s = np.sqrt(r1)
+    w = np.stack([1 - s, s * (1 - r2), s * r2], 1)  # barycentric weights, uniform on the triangle
+    p_O = w[:, :1] * a[tri] + w[:, 1:2] * b[tri] + w[:, 2:] * c[tri]
+    n_O = cross[tri] / area2[tri, None]
+    labels = L[F[tri, np.argmax(w, axis=1)]].astype(np.int64)
+    return p_O, n_O, labels
+
+
+# ------------------------------------------------------------------------------------------------
+# tg-drake objects
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    parser.add_argument("--category", choices=CATEGORIES, help="only this category")
+
+
+def _row(o: LibraryObject) -> dict:
+    return {"id": o.id, "category": o.category, "material": o.material,
+            "extents": list(o.extents), "mass": o.mass, "parts": list(o.parts),
+            "poses": list(o.poses), "cavity_volume": o.cavity_volume,
+            "sdf": o.sdf_url}
+
+
+def main(args) -> int:
+    objs = [o for o in load_library().values()
+            if args.category is None or o.category == args.category]
+    if args.json:
+        print(json.dumps([_row(o) for o in objs], indent=1))
+        return 0
+    print(f"{'id':16s} {'category':12s} {'material':10s} {'size x×y×z [cm]':18s} "
+          f"{'mass [kg]':>9s}  parts")
+    for o in objs:
+        size = "×".join(f"{100 * e:.1f}" for e in o.extents)
+        print(f"{o.id:16s} {o.category:12s} {o.material:10s} {size:18s} {o.mass:9.3f}  "
+              f"{', '.join(o.parts)}")
+    print(f"{len(objs)} objects")
+    return 0
