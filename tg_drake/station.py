@@ -63,7 +63,7 @@ def placement_pose(scenario: Scenario, placement: ObjectPlacement) -> RigidTrans
     from tg_drake.objects import get_object
 
     obj = get_object(placement.id)
-    X_TO = obj.resting_pose(placement.pose)
+    X_TO = obj.resting_pose(placement.pose).X_TO
     X_T_yaw = RigidTransform(RollPitchYaw(0, 0, np.deg2rad(placement.yaw)),
                              [placement.xy[0], placement.xy[1], 0.0])
     X_WT = scenario.X_WT.GetDeterministicValue()
@@ -137,22 +137,32 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser
     from tg_drake.objects import get_object
 
     directives = [ModelDirective(add_model=AddModel(
-        name=p.instance_name, file=get_object(p.id).package_url)) for p in scenario.objects]
+        name=p.instance_name, file=get_object(p.id).sdf_url)) for p in scenario.objects]
     added = ProcessModelDirectives(ModelDirectives(directives=directives), parser)
     objects = {}
     for placement, info in zip(scenario.objects, added):
         instance = info.model_instance
         objects[placement.instance_name] = instance
         body = plant.get_body(plant.GetBodyIndices(instance)[0])
-        plant.SetDefaultFreeBodyPose(body, placement_pose(scenario, placement))
+        plant.SetDefaultFloatingBaseBodyPose(body, placement_pose(scenario, placement))
         if placement.containment == "full":
             _add_contents(plant, instance, body, get_object(placement.id))
     return objects
 
 
+def contents_cylinder(obj) -> tuple[float, float, np.ndarray]:
+    """(radius, height, p_OC): the water of a full container as a cylinder of the cavity's volume,
+    of the inner diameter, standing on the container's base (O: origin at the bottom centre, z up)."""
+    d = obj.dimensions
+    radius = d["diameter"] / 2 - d.get("wall", 0.0)
+    height = obj.cavity_volume / (np.pi * radius**2)
+    return radius, height, np.array([0.0, 0.0, d.get("base", d.get("wall", 0.0)) + height / 2])
+
+
 def _add_contents(plant: MultibodyPlant, instance, body, obj) -> None:
-    """A "full" container: water filling its cavity, as a solid cylinder welded inside it."""
-    radius, height, p_OC = obj.cavity_cylinder()
+    """A "full" container: water filling its cavity, as a solid cylinder welded inside it (mass
+    and inertia only; the water has no geometry)."""
+    radius, height, p_OC = contents_cylinder(obj)
     mass = WATER_DENSITY * obj.cavity_volume
     M = SpatialInertia(mass=mass, p_PScm_E=np.zeros(3),
                        G_SP_E=UnitInertia.SolidCylinder(radius, height, [0, 0, 1]))
