@@ -18,6 +18,7 @@ HELP = "measure the speed figures (JSON of medians and ratios against references
 
 # figure name → "module:function" returning a Figure. Order is the output order.
 FIGURES: dict[str, str] = {
+    "sim_rtf": "tg_drake.scripted:bench_sim_rtf",
 }
 
 
@@ -27,7 +28,7 @@ class Figure:
     unit: str
     reference: str | None = None  # what the reference is
     reference_median: float | None = None
-    speedup: float | None = None  # reference_median / median (> 1: we are faster)
+    speedup: float | None = None  # > 1: we are faster (reference/median for times, median/reference for rates)
 
 
 def median_time(fn: Callable[[], object], *, repeats: int = 5, warmup: int = 1) -> float:

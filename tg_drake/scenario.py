@@ -121,7 +121,19 @@ class WsgPdDriver:
     force_limit: float = 40.0  # [N] per finger; the WSG 50 drive allows up to 80 N.
 
 
-DriverConfig = typing.Union[JointPdDriver, WsgPdDriver]
+@dataclass
+class InverseDynamicsDriver:
+    """The iiwa under an explicit inverse-dynamics controller (Drake's
+    `InverseDynamicsController` on a model of the arm with the gripper as payload), its torques on
+    the plant's actuation input. Drake's conventional choice; it needs a small time step (about
+    1–2 ms) to stay stable, where the PD-in-plant driver runs at 5–10 ms."""
+
+    kp: float = 100.0  # [1/s²]
+    ki: float = 1.0  # [1/s³]
+    kd: float = 20.0  # [1/s]
+
+
+DriverConfig = typing.Union[JointPdDriver, WsgPdDriver, InverseDynamicsDriver]
 
 
 def default_drivers() -> dict[str, DriverConfig]:

@@ -130,3 +130,30 @@ def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: flo
     held = bool(object_rise > 0.8 * gripper_rise and opening > 0.005)
     return GraspLiftResult(held, float(object_rise), float(gripper_rise), opening, surfaces,
                            times[-1], wall, render_time)
+
+
+def bench_sim_rtf():
+    """`sim_rtf`: simulated seconds per wall second of the scripted grasp-and-lift of a full can
+    (6.5 s simulated), one camera frame rendered at its start. The reference is the same run with
+    Drake's explicit inverse-dynamics arm controller at a 2 ms step; `speedup` = ours / reference
+    (a rate: higher is better)."""
+    from tg_drake.bench import Figure
+    from tg_drake.objects import get_object
+    from tg_drake.scenario import InverseDynamicsDriver, ObjectPlacement
+
+    def run(explicit: bool) -> float:
+        scenario = Scenario()
+        scenario.objects = [ObjectPlacement(id="can_02", pose="upright", yaw=90,
+                                            containment="full")]
+        if explicit:
+            scenario.model_drivers["iiwa"] = InverseDynamicsDriver()
+            scenario.plant_config.time_step = 0.002
+        height = get_object("can_02").extents[2]
+        r = grasp_and_lift(scenario, object_name="can_02", p_W_grasp=[0.75, 0.0, 0.5 * height])
+        return r.sim_time / (r.wall_time + r.render_time)
+
+    ours = sorted(run(False) for _ in range(3))[1]
+    reference = sorted(run(True) for _ in range(3))[1]
+    return Figure(median=ours, unit="simulated s / wall s",
+                  reference="explicit InverseDynamicsController, 2 ms step, same grasp-and-lift",
+                  reference_median=reference, speedup=ours / reference)

@@ -40,7 +40,8 @@ from pydrake.systems.primitives import MatrixGain
 from pydrake.systems.sensors import CameraInfo, RgbdSensor
 
 from tg_drake.errors import ModelError, ScenarioError
-from tg_drake.scenario import JointPdDriver, ObjectPlacement, Scenario, WsgPdDriver
+from tg_drake.scenario import (InverseDynamicsDriver, JointPdDriver, ObjectPlacement, Scenario,
+                               WsgPdDriver)
 
 WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container
 
@@ -191,6 +192,8 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
             raise ScenarioError(f"model_drivers names '{name}', which the directives do not add; "
                                 f"models: {', '.join(instances)}", field="model_drivers")
         instance = instances[name]
+        if isinstance(driver, InverseDynamicsDriver):
+            continue  # its controller is added after Finalize
         _apply_joint_pd(plant, instance, driver.kp, driver.kd)
         if isinstance(driver, WsgPdDriver):
             for actuator in _actuators(plant, instance):
@@ -205,8 +208,14 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
 
     # Ports of the arm and the gripper.
     if "iiwa" in instances:
-        station.inputs["iiwa.desired_state"] = plant.get_desired_state_input_port(instances["iiwa"])
-        station.outputs["iiwa.state"] = plant.get_state_output_port(instances["iiwa"])
+        iiwa = instances["iiwa"]
+        driver = scenario.model_drivers.get("iiwa")
+        if isinstance(driver, InverseDynamicsDriver):
+            controller = _add_inverse_dynamics(builder, scenario, plant, iiwa, driver)
+            station.inputs["iiwa.desired_state"] = controller.get_input_port_desired_state()
+        else:
+            station.inputs["iiwa.desired_state"] = plant.get_desired_state_input_port(iiwa)
+        station.outputs["iiwa.state"] = plant.get_state_output_port(iiwa)
     if "wsg" in instances:
         # Opening width w → finger joint positions (−w/2, +w/2), zero velocities.
         to_state = builder.AddNamedSystem("wsg_width_to_desired_state",
@@ -247,6 +256,36 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
         station.outputs[f"{name}.label_image"] = sensor.label_image_output_port()
         station.outputs[f"{name}.camera_pose"] = pose.get_output_port()
     return station
+
+
+def _add_inverse_dynamics(builder, scenario, plant, iiwa, driver):
+    """Drake's explicit inverse-dynamics controller for the arm, the gripper as its payload."""
+    from pydrake.multibody.plant import MultibodyPlant as Plant
+    from pydrake.systems.controllers import InverseDynamicsController
+
+    control_plant = Plant(time_step=0.0)
+    parser = make_parser(control_plant)
+    kept = [d for d in scenario.directives
+            if (d.add_model and d.add_model.name in ("iiwa", "wsg"))
+            or (d.add_weld and d.add_weld.child.split("::")[0] in ("iiwa", "wsg"))]
+    ProcessModelDirectives(ModelDirectives(directives=kept), parser)
+    wsg = control_plant.GetModelInstanceByName("wsg")
+    for joint in ("left_finger_sliding_joint", "right_finger_sliding_joint"):
+        # The fingers' mass rides along as payload; their joints are locked for the controller.
+        j = control_plant.GetJointByName(joint, wsg)
+        parent, child = j.frame_on_parent(), j.frame_on_child()
+        control_plant.RemoveJointActuator(control_plant.GetJointActuatorByName(joint, wsg))
+        control_plant.RemoveJoint(j)
+        control_plant.WeldFrames(parent, child)
+    control_plant.Finalize()
+    n = control_plant.num_positions()
+    controller = builder.AddNamedSystem("iiwa_inverse_dynamics", InverseDynamicsController(
+        control_plant, kp=[driver.kp] * n, ki=[driver.ki] * n, kd=[driver.kd] * n,
+        has_reference_acceleration=False))
+    controller.set_name("iiwa_inverse_dynamics")
+    builder.Connect(plant.get_state_output_port(iiwa), controller.get_input_port_estimated_state())
+    builder.Connect(controller.get_output_port_control(), plant.get_actuation_input_port(iiwa))
+    return controller
 
 
 def _with_renderer(color_camera, renderer_name: str):
