@@ -66,15 +66,15 @@ def test_flat_plate_has_constant_depth_and_zero_gradient():
 
 def test_step_gradient_is_the_step_height_next_to_the_edge():
     # Height field: depth 0.03 m for x_G < 0, 0.05 m for x_G ≥ 0. x_G = 0 is the boundary between
-    # pixels u = 7 and u = 8 (pixels start at −0.056 m, 7 mm each).
+    # pixels u = 9 and u = 10 (20 pixels of 7 mm from −0.070 m).
     x, z = grid((-0.08, 0.08), (-0.03, 0.03))
     p_G = in_gripper(x, np.where(x < 0, 0.03, 0.05), z)
     di = depth_images(p_G, np.eye(4))[0]
-    expected_di = np.repeat(np.r_[np.full(8, 0.03), np.full(8, 0.05)][:, None], 3, axis=1)
+    expected_di = np.repeat(np.r_[np.full(10, 0.03), np.full(10, 0.05)][:, None], 3, axis=1)
     np.testing.assert_allclose(di, expected_di, atol=1e-12)
-    # DGI pixel i is DI pixel u = i + 1: DI(8) − DI(6) = DI(9) − DI(7) = 0.02 at u = 7 and 8.
-    expected_dgi = np.zeros((14, 1))
-    expected_dgi[[6, 7]] = 0.02
+    # DGI pixel i is DI pixel u = i + 1: DI(10) − DI(8) = DI(11) − DI(9) = 0.02 at u = 9, 10.
+    expected_dgi = np.zeros((18, 1))
+    expected_dgi[[8, 9]] = 0.02
     np.testing.assert_allclose(depth_gradient_images(di), expected_dgi, atol=1e-12)
 
 
@@ -88,13 +88,15 @@ def test_cylinder_depth_follows_its_circle():
     p_G = in_gripper(r * np.sin(tt.ravel()), c - r * np.cos(tt.ravel()), zz.ravel())
     di = depth_images(p_G, np.eye(4))[0]
 
-    edges = -0.056 + 0.007 * np.arange(17)
+    edges = -0.070 + 0.007 * np.arange(21)
     lo, hi = edges[:-1], edges[1:]
     x_star = np.where((lo <= 0) & (hi > 0), 0.0, np.minimum(np.abs(lo), np.abs(hi)))
     expected = np.where(x_star < r, c - np.sqrt(np.maximum(r**2 - x_star**2, 0.0)), EMPTY_DEPTH)
-    # Pixels u = 3 and 12 start at |x| = 0.028 m: 0.05 − sqrt(0.03² − 0.028²) = 0.039230 m.
-    assert expected[3] == pytest.approx(0.0392297, abs=1e-6)
-    assert expected[7] == expected[8] == pytest.approx(0.02)
+    # Pixels u = 5 and 14 reach |x| = 0.028 m: 0.05 − sqrt(0.03² − 0.028²) = 0.039230 m.
+    assert expected[5] == pytest.approx(0.0392297, abs=1e-6)
+    assert expected[14] == pytest.approx(0.0392297, abs=1e-6)
+    assert expected[9] == expected[10] == pytest.approx(0.02)
+    assert np.all(expected[:4] == EMPTY_DEPTH) and np.all(expected[16:] == EMPTY_DEPTH)
     # 1e-4 m: with 0.02 mm arc steps the sampled point nearest a cell edge is within 0.02 mm of
     # it in x, and the circle's slope there is below 2.6, so the sampled minimum is within 0.06 mm.
     np.testing.assert_allclose(di, np.repeat(expected[:, None], 3, axis=1), atol=1e-4)
@@ -111,8 +113,9 @@ def test_empty_volume_gives_minus_one_and_zero_gradient():
     beside = in_gripper(x, np.full_like(x, 0.03), z + 0.05)  # beyond the pads' width
     for cloud in (behind_palm, past_tips, beside):
         f = dgi_features(cloud, np.eye(4))
-        np.testing.assert_array_equal(f[0, :48], EMPTY_DEPTH)
-        np.testing.assert_array_equal(f[0, 48:], 0.0)
+        n_di = CFG.n_u * CFG.n_v
+        np.testing.assert_array_equal(f[0, :n_di], EMPTY_DEPTH)
+        np.testing.assert_array_equal(f[0, n_di:], 0.0)
 
 
 def test_features_do_not_depend_on_the_world_frame_and_are_vectorised():
@@ -165,4 +168,6 @@ def test_constants_match_the_wsg_model():
         # The pad's inner face at full stroke: its centre offset minus half its thickness.
         inner_face = stroke + pose[0] - sign * PAD_SIZE[0] / 2
         assert abs(inner_face) == pytest.approx(MAX_OPENING / 2)
-    assert CFG.half_extent_x >= MAX_OPENING / 2 and CFG.half_extent_z >= PAD_SIZE[2] / 2
+    # The volume covers both open pads and their width.
+    assert CFG.half_extent_x >= MAX_OPENING / 2 + PAD_SIZE[0]
+    assert CFG.half_extent_z >= PAD_SIZE[2] / 2

@@ -50,13 +50,15 @@ EMPTY_DEPTH = -1.0  # DI of a pixel whose cell holds no point (paper eq. 3).
 class DgiConfig:
     """The closing volume and its pixel grid, in the gripper frame G.
 
-    The volume is the box swept by the pads as they close: x_G over the full opening, y_G from the
-    palm to the fingertips (the depth axis, depth = y_G − base_y), z_G over the pad width. The pixel
-    grid covers it with `n_u` × `n_v` square cells of side `cell_size`, centred on x_G = z_G = 0.
+    The volume is the box swept by the pads as they close, pads included: x_G over the full
+    opening plus the pads' thickness, y_G from the palm to the fingertips (the depth axis,
+    depth = y_G − base_y), z_G over the pad width. The pixel grid covers it with `n_u` × `n_v`
+    square cells of side `cell_size`, centred on x_G = z_G = 0.
     """
 
     cell_size: float = CELL_SIZE  # pixel side [m].
-    n_u: int = 16  # pixels along x_G: 16 × 7 mm = 112 mm ⊇ the 110 mm opening.
+    n_u: int = 20  # pixels along x_G: 20 × 7 mm = 140 mm ⊇ the 134 mm from the outer face of
+    # one open pad to the other's, so that the DI also shows what the pads land on.
     n_v: int = 3  # pixels along z_G: 3 × 7 mm = 21 mm ⊇ the 20 mm pad width.
     base_y: float = GRIPPER_BASE_Y  # y_G of the gripper base (depth 0) [m].
     tip_y: float = FINGERTIP_Y  # y_G of the fingertips (largest depth) [m].

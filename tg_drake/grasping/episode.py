@@ -52,6 +52,7 @@ from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem
 from tg_drake.errors import SimulationError
 from tg_drake.grasping.dgi import MAX_OPENING
 
+TABLE_TOP_Z = 0.0  # the table's top surface in the world [m] (table_top frame welded at W).
 FINGER_JOINTS = ("left_finger_sliding_joint", "right_finger_sliding_joint")
 CARRIER_JOINTS = ("carrier_x", "carrier_y", "carrier_z", "carrier_rx", "carrier_ry", "carrier_rz")
 
@@ -77,6 +78,8 @@ class EpisodeConfig:
     carrier_kd_translation: float = 2.0e3  # [N·s/m]: well damped for the 1.1 kg gripper.
     carrier_kp_rotation: float = 2.0e3  # [N·m/rad]
     carrier_kd_rotation: float = 20.0  # [N·m·s/rad]
+    carrier_force_limit: float = 150.0  # [N] per translation joint: an arm pushes no harder.
+    carrier_torque_limit: float = 15.0  # [N·m] per rotation joint.
     min_finger_gap: float = 0.002  # an object is between the fingers if they stop this far apart [m].
     min_lift_fraction: float = 0.5  # ... and it rose this share of lift_height.
 
@@ -210,7 +213,8 @@ class GraspWorld:
                 child = plant.GetFrameByName("body", wsg)
             joint_type = PrismaticJoint if k < 3 else RevoluteJoint
             joint = plant.AddJoint(joint_type(name, parent, child, axes[k % 3]))
-            actuator = plant.AddJointActuator(name, joint)
+            actuator = plant.AddJointActuator(
+                name, joint, config.carrier_force_limit if k < 3 else config.carrier_torque_limit)
             kp, kd = ((config.carrier_kp_translation, config.carrier_kd_translation) if k < 3
                       else (config.carrier_kp_rotation, config.carrier_kd_rotation))
             actuator.set_controller_gains(PdControllerGains(p=kp, d=kd))
@@ -289,7 +293,7 @@ class GraspWorld:
             return "NaN in the state"
         X = self.plant.EvalBodyPoseInWorld(plant_context, self.object_body)
         p = X.translation()
-        if p[2] < z0 - 0.05:
+        if p[2] < TABLE_TOP_Z - 0.05:  # its origin 5 cm under the top: not resting on it
             return "object fell through the table"
         if np.linalg.norm(p[:2]) > 2.0 or p[2] > 2.0:
             return "object flew off"
