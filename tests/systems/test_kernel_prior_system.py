@@ -100,3 +100,19 @@ def test_bad_cloud_is_a_kernel_error(database):
         context, SceneDescription(objects=[obj], X_WT=np.eye(4)))
     with pytest.raises(KernelError, match=r"unknown part label\(s\) \[9\]"):
         system.get_category_prior_output_port().Eval(context)
+
+
+def test_default_system_uses_the_shipped_database():
+    from tg_drake.kernels.library import sample_object
+    from tg_drake.objects import get_object
+
+    system = KernelPriorSystem()  # the database in tg_drake/data, its T.
+    assert system.database.object_ids.size > 0
+    context = system.CreateDefaultContext()
+    cloud = sample_object(get_object("can_02"), rng=np.random.default_rng(4))
+    system.get_scene_description_input_port().FixValue(
+        context, SceneDescription(objects=[_object(cloud, [0.6, 0.0, 0.75])], X_WT=np.eye(4)))
+    (dist,) = system.get_category_prior_output_port().Eval(context).distributions
+    assert len(dist.neighbours) == 10  # the paper's n.
+    assert dist.probabilities.sum() == pytest.approx(1.0, abs=1e-12)
+    assert CATEGORIES[int(np.argmax(dist.probabilities))] == "can"
