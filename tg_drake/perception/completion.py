@@ -1,0 +1,313 @@
+"""Symmetry-based shape completion (paper section III-A) and the circle test (III-B).
+
+Works in the table frame T (origin on the table top, z up along the table normal). Following the
+paper:
+
+- the vertical box direction is the table normal and its length the largest height, d_z;
+- the horizontal box directions are the PCA eigenvectors of W, the visible points projected
+  onto the table plane;
+- the xy-centroid c_xy is the centroid of the top region, the points higher than σ·d_z (their
+  projection is symmetric about the axis when the top is seen, Fig. 3 of the paper);
+- the symmetry axis s is the box direction left over by the pair of box directions whose
+  dimensions are the closest (the cross product of that pair); it passes through the box centroid;
+- the visible points P are rotated 180° about s and added to P.
+
+Two additions, both built on the paper's own circle test for handles ("a circle fitted in the
+projected points W with a large confidence; the points lying outside it are handle"):
+
+1. The circle test is run for every candidate axis on the points projected along it (for the
+   vertical axis that is W, the paper's case). A rotationally symmetric object has a circular
+   cross-section about its axis and about no other box direction, so when exactly one candidate
+   passes, it is the axis; otherwise the paper's closest-dimensions rule decides. This keeps a
+   mug or a pan upright although its handle stretches one horizontal dimension of the box, and
+   the closest-dimensions rule alone would call it sideways.
+2. Handle points (outside the circle) are not rotated: the handle is the part that breaks the
+   rotational symmetry, and rotating it would add a second, phantom handle.
+
+The test works on the outline of the folded cross-section: the 180° rotation about the axis maps
+polar angle θ to θ + π, so the completed outline radius in direction θ is the largest radius
+seen at θ or θ + π. A circle is an outline of constant radius R, except for at most one run of
+directions where a handle reaches beyond it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tg_drake.errors import PerceptionError
+from tg_drake.perception.config import CompletionConfig
+
+# The top region is a ridge along a lying object's axis when its principal variance is this many
+# times its secondary one (a strip at least twice as long as wide).
+RIDGE_EIGEN_RATIO = 4.0
+
+
+@dataclass
+class CircleFit:
+    """Result of the circle test on points projected along a candidate axis."""
+
+    ok: bool  # a circle (with at most one handle) fits with confidence ≥ min_circle_fraction.
+    radius: float  # R [m].
+    confidence: float  # share of the non-handle outline bins on the circle.
+    handle: np.ndarray  # (N,) bool: points outside the circle, in the handle's directions.
+    handle_direction: np.ndarray  # (2,) unit direction of the handle in the plane, or zeros.
+    rim: np.ndarray  # (M,) int indices of the outline points on the circle.
+
+
+@dataclass
+class Completion:
+    """A completed object in the table frame T."""
+
+    p_T: np.ndarray  # (N, 3) visible points followed by the rotated ones [m].
+    n_T: np.ndarray  # (N, 3) unit normals, outwards from the symmetry axis.
+    visible: np.ndarray  # (N,) bool: observed points.
+    handle: np.ndarray  # (N,) bool: handle points (observed only; never rotated).
+    p_TA: np.ndarray  # (3,) a point on the symmetry axis (the body's box centroid) [m].
+    axis_T: np.ndarray  # (3,) unit symmetry axis direction (up when vertical).
+    vertical: bool  # the axis is the table normal.
+    R_TB: np.ndarray  # 3×3 box directions as columns: (e1, e2, up) in the table plane.
+    box_dims: np.ndarray  # (3,) visible box dimensions along R_TB's columns [m].
+    circle: CircleFit | None  # the circle test about the chosen axis (None if it failed).
+    handle_direction_T: np.ndarray  # (3,) unit direction from the axis to the handle, or zeros.
+    axis_margin: float  # confidence in the axis decision, in [0.5, 1].
+    d_z: float  # height of the highest point [m].
+
+
+def _largest_cyclic_run(mask: np.ndarray) -> np.ndarray:
+    """Boolean mask of the longest run of True in a cyclic boolean array."""
+    n = len(mask)
+    if mask.all():
+        return mask.copy()
+    doubled = np.concatenate([mask, mask])
+    idx = np.arange(2 * n)
+    last_false = np.maximum.accumulate(np.where(doubled, -1, idx))
+    length = idx - last_false
+    end = int(np.argmax(length))
+    run = np.zeros(n, bool)
+    if length[end] > 0:
+        run[np.arange(end - length[end] + 1, end + 1) % n] = True
+    return run
+
+
+def _median(x: np.ndarray) -> float:
+    """Median of a short vector (np.median's generality costs more than the sort)."""
+    x = np.sort(x)
+    n = len(x)
+    return float(0.5 * (x[(n - 1) // 2] + x[n // 2]))
+
+
+def circle_test(q: np.ndarray, cfg: CompletionConfig) -> CircleFit:
+    """Circle test on (N, 2) points q centred on a candidate symmetry axis (the axis at 0)."""
+    n_bins = max(4, cfg.circle_bins // 2)
+    rho = np.hypot(q[:, 0], q[:, 1])
+    theta = np.mod(np.arctan2(q[:, 1], q[:, 0]), np.pi)
+    k = np.minimum((theta / (np.pi / n_bins)).astype(int), n_bins - 1)
+    outline = np.zeros(n_bins)
+    np.maximum.at(outline, k, rho)
+    occupied = outline > 0
+    fail = CircleFit(False, 0.0, 0.0, np.zeros(len(q), bool), np.zeros(2), np.zeros(0, int))
+    if occupied.mean() < cfg.min_circle_coverage:
+        return fail
+    radius = _median(outline[occupied])
+    if radius <= 0:
+        return fail
+    outside = occupied & (outline > (1 + cfg.circle_tolerance) * radius)
+    run = _largest_cyclic_run(outside)
+    is_handle = (run.any() and run.sum() <= cfg.max_handle_fraction * n_bins
+                 and outline[run].max() >= (1 + cfg.handle_min_protrusion) * radius)
+    handle_bins = run if is_handle else np.zeros(n_bins, bool)
+    rest = occupied & ~handle_bins
+    on_circle = rest & (np.abs(outline - radius) <= cfg.circle_tolerance * radius)
+    radius = _median(outline[on_circle]) if on_circle.any() else radius
+    confidence = float(on_circle.sum() / max(rest.sum(), 1))
+    handle = handle_bins[k] & (rho > (1 + cfg.circle_tolerance) * radius)
+    direction = np.zeros(2)
+    if handle.sum() >= cfg.min_handle_points:
+        mean = q[handle].mean(axis=0)
+        direction = mean / max(np.linalg.norm(mean), 1e-12)
+    else:
+        handle[:] = False
+    rim = np.flatnonzero((rho == outline[k]) & on_circle[k])
+    return CircleFit(confidence >= cfg.min_circle_fraction, radius, confidence, handle,
+                     direction, rim)
+
+
+def _rotate_180(p: np.ndarray, p_A: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """Rotates points (or, with p_A = 0, vectors) by 180° about the axis through p_A along a."""
+    d = p - p_A
+    return p_A + 2.0 * np.outer(d @ a, a) - d
+
+
+def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = None
+             ) -> Completion:
+    """Completes the visible points P of one object by the paper's line-reflection symmetry.
+
+    Args:
+        p_T: (N, 3) visible points in the table frame (z = height above the table) [m].
+        n_T: (N, 3) their unit normals, oriented towards the camera.
+        cfg: completion parameters.
+    """
+    cfg = cfg or CompletionConfig()
+    p_T = np.asarray(p_T, float)
+    n_T = np.asarray(n_T, float)
+    if p_T.ndim != 2 or p_T.shape[1] != 3 or n_T.shape != p_T.shape:
+        raise PerceptionError(
+            f"completion needs (N, 3) points and normals, got {p_T.shape} and {n_T.shape}")
+    if len(p_T) < 10:
+        raise PerceptionError(f"completion needs at least 10 visible points, got {len(p_T)}")
+    if not np.all(np.isfinite(p_T)) or not np.all(np.isfinite(n_T)):
+        raise PerceptionError("completion got non-finite points or normals")
+    z = p_T[:, 2]
+    d_z = float(z.max())
+    if d_z <= 0:
+        raise PerceptionError(
+            f"the object's points are not above the table (highest point {d_z:.4f} m)")
+    W = p_T[:, :2]
+
+    # Horizontal box directions: PCA of W (sign fixed so that e1 has x ≥ 0 in T).
+    _, evecs = np.linalg.eigh(np.cov(W.T))
+    e1 = evecs[:, 1] * (1.0 if evecs[0, 1] >= 0 else -1.0)
+    e2 = np.array([-e1[1], e1[0]])
+
+    # Candidate axes: the vertical, the two horizontal box directions and, when the top region
+    # is a ridge (a lying object's top), the ridge's direction: W's PCA is a poor guide to the
+    # axis when W is nearly square (a short lying mug), its top ridge is not.
+    top = z > cfg.sigma * d_z
+    c_top = W[top].mean(axis=0)
+    directions = [e1, e2]
+    if top.sum() >= 10:
+        evals_t, evecs_t = np.linalg.eigh(np.cov(W[top].T))
+        if evals_t[1] > RIDGE_EIGEN_RATIO * max(evals_t[0], 1e-12):
+            directions.append(evecs_t[:, 1] * (1.0 if evecs_t[0, 1] >= 0 else -1.0))
+    candidates = [_vertical_candidate(W, top, c_top, d_z, e1, e2, cfg)]
+    candidates += [_horizontal_candidate(W, z, c_top, d_z, d, cfg) for d in directions]
+
+    # Choose: the one candidate whose cross-section is a circle; else the paper's rule (the axis
+    # is the box direction not in the pair of closest dimensions) among the passing candidates,
+    # or among the PCA box's three directions when none passes.
+    passing = [c for c in candidates if c.fit.ok]
+    if len(passing) == 1:
+        chosen, margin = passing[0], passing[0].fit.confidence
+    elif passing and not any(c.vertical for c in passing):
+        chosen = max(passing, key=lambda c: c.fit.confidence)
+        margin = chosen.fit.confidence
+    else:
+        ranked = sorted(passing or candidates[:3], key=lambda c: c.gap)
+        chosen = ranked[0]
+        g0, g1 = ranked[0].gap, (ranked[1].gap if len(ranked) > 1 else np.inf)
+        margin = 1.0 - g0 / max(g0 + g1, 1e-12) if np.isfinite(g1) else 1.0
+    fit = chosen.fit if chosen.fit.ok else None
+    handle = fit.handle if fit is not None else np.zeros(len(W), bool)
+    p_TA, a = chosen.p_TA, chosen.a
+    if fit is None:
+        handle_direction = np.zeros(3)
+    else:  # the circle test's plane has axes (b, up) for a horizontal axis, (x, y) for vertical.
+        u, v = ((np.array([1.0, 0, 0]), np.array([0, 1.0, 0])) if chosen.vertical
+                else (np.append(chosen.b, 0.0), np.array([0, 0, 1.0])))
+        handle_direction = fit.handle_direction[0] * u + fit.handle_direction[1] * v
+    dims = np.array([2 * np.abs((W - p_TA[:2]) @ e1).max(),
+                     2 * np.abs((W - p_TA[:2]) @ e2).max(), d_z])
+
+    # Rotate the body (not the handle) 180° about the axis.
+    body = ~handle
+    p_rot = _rotate_180(p_T[body], p_TA, a)
+    n_rot = _rotate_180(n_T[body], np.zeros(3), a)
+    p_all = np.concatenate([p_T, p_rot])
+    n_all = np.concatenate([n_T, n_rot])
+    # Outwards: away from the axis point (radially for walls, along the axis for end faces).
+    flip = np.einsum("ij,ij->i", n_all, p_all - p_TA) < 0
+    n_all[flip] *= -1
+    visible = np.concatenate([np.ones(len(p_T), bool), np.zeros(len(p_rot), bool)])
+    handle_all = np.concatenate([handle, np.zeros(len(p_rot), bool)])
+    R_TB = np.column_stack([np.append(e1, 0.0), np.append(e2, 0.0), [0.0, 0.0, 1.0]])
+    return Completion(p_all, n_all, visible, handle_all, p_TA, a, chosen.vertical, R_TB, dims,
+                      fit, handle_direction, float(np.clip(margin, 0.5, 1.0)), d_z)
+
+
+@dataclass
+class _Candidate:
+    """A candidate symmetry axis and its circle test."""
+
+    vertical: bool
+    a: np.ndarray  # (3,) unit axis direction in T.
+    b: np.ndarray  # (2,) horizontal direction across a horizontal axis (zeros when vertical).
+    fit: CircleFit
+    p_TA: np.ndarray  # (3,) axis point in T.
+    gap: float  # the paper's rule: difference of the two box dimensions across the axis [m].
+
+
+def _vertical_candidate(W: np.ndarray, top: np.ndarray, c_top: np.ndarray, d_z: float,
+                        e1: np.ndarray, e2: np.ndarray, cfg: CompletionConfig) -> _Candidate:
+    """The vertical axis through the top region's centroid (paper), at half the height."""
+    fit, c = _vertical_fit(W, top, c_top, cfg)
+    if not fit.ok:
+        # A handle at rim height (a pan's) pulls the top region's centroid towards it and
+        # stretches W along the handle. Across the handle (e2) W spans the body's diameter
+        # 2R; along it, the body's centre is R in from the end of W without the handle.
+        # Try both ends and keep the best circle test.
+        s1, s2 = W @ e1, W @ e2
+        radius = 0.5 * (s2.max() - s2.min())
+        mid2 = 0.5 * (s2.max() + s2.min())
+        for s1_c in (s1.min() + radius, s1.max() - radius):
+            fit2, c2 = _vertical_fit(W, top, s1_c * e1 + mid2 * e2, cfg)
+            if fit2.confidence > fit.confidence:
+                fit, c = fit2, c2
+    body = ~fit.handle if fit.ok else np.ones(len(W), bool)
+    gap = abs(2 * np.abs((W[body] - c) @ e1).max() - 2 * np.abs((W[body] - c) @ e2).max())
+    return _Candidate(True, np.array([0.0, 0.0, 1.0]), np.zeros(2), fit,
+                      np.array([c[0], c[1], 0.5 * d_z]), gap)
+
+
+def _horizontal_candidate(W: np.ndarray, z: np.ndarray, c_top: np.ndarray, d_z: float,
+                          a: np.ndarray, cfg: CompletionConfig) -> _Candidate:
+    """A horizontal axis along a through the top region's centroid across it (paper).
+
+    Along the axis its point is the middle of the visible extent; its height is d_z / 2 (the
+    box centroid) or, when that fits the circle better, the radius of a round body lying on
+    the table: a handle sticking up raises d_z but not the body's axis.
+    """
+    b = np.array([-a[1], a[0]])
+    s_a = W @ a
+    across = (W - c_top) @ b
+    best: tuple[CircleFit, float] | None = None
+    for height in (0.5 * d_z, 0.5 * (across.max() - across.min())):
+        fit = circle_test(np.column_stack([across, z - height]), cfg)
+        if best is None or (fit.ok, fit.confidence) > (best[0].ok, best[0].confidence):
+            best = (fit, height)
+        if fit.ok:
+            break
+    fit, height = best
+    if not fit.ok:  # no circle: the paper's box centroid.
+        height = 0.5 * d_z
+    p_xy = 0.5 * (s_a.min() + s_a.max()) * a + (c_top @ b) * b
+    gap = abs(2 * np.abs(across[~fit.handle] if fit.ok else across).max() - d_z)
+    return _Candidate(False, np.append(a, 0.0), b, fit, np.array([p_xy[0], p_xy[1], height]),
+                      gap)
+
+
+def _vertical_fit(W: np.ndarray, top: np.ndarray, c: np.ndarray, cfg: CompletionConfig
+                  ) -> tuple[CircleFit, np.ndarray]:
+    """Circle test of W about c (the paper's top-region centroid).
+
+    Once the handle is known, c is recomputed without it. When the test passes, the centre is
+    refined by a least-squares (Kåsa) circle through the outline points on the circle: the
+    top region of a bottle is its neck, whose visible side pulls the centroid towards the
+    camera by a few millimetres, enough to make the body look lopsided.
+    """
+    fit = circle_test(W - c, cfg)
+    for _ in range(2):
+        keep = top & ~fit.handle
+        if not fit.handle.any() or not keep.any():
+            break
+        c = W[keep].mean(axis=0)
+        fit = circle_test(W - c, cfg)
+    if fit.ok and len(fit.rim) >= 3:
+        rim = W[fit.rim] - c
+        A = np.column_stack([2 * rim, np.ones(len(rim))])
+        sol, *_ = np.linalg.lstsq(A, (rim ** 2).sum(axis=1), rcond=None)
+        refit = circle_test(W - (c + sol[:2]), cfg)
+        if refit.ok:
+            fit, c = refit, c + sol[:2]
+    return fit, c

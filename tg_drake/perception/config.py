@@ -1,0 +1,86 @@
+"""Parameters of the perception stage (paper section III-A/B), one dataclass per step.
+
+Every field has a default and a unit. The defaults are the values our evaluation uses
+(`tools/eval_perception.py`); the paper gives only σ's meaning, not its value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass
+class SegmentationConfig:
+    """Table plane (RANSAC) and object clusters (DBSCAN) from a depth cloud."""
+
+    plane_distance: float = 0.005  # RANSAC inlier distance to the table plane [m].
+    ransac_points: int = 20000  # RANSAC runs on at most this many points (a stride subsample).
+    ransac_iterations: int = 300  # RANSAC iterations per plane.
+    max_planes: int = 3  # planes tried before giving up on finding a horizontal table.
+    max_table_tilt_deg: float = 25.0  # a table normal is at most this far from world +z [deg].
+    min_table_fraction: float = 0.05  # a table holds at least this share of the cloud.
+    min_object_height: float = 0.004  # object points are this far above the plane [m].
+    max_object_height: float = 0.6  # ... and at most this far [m].
+    table_margin: float = 0.0  # objects' points may lie this far outside the table's extent [m].
+    voxel_size: float = 0.004  # object points are averaged per voxel of this side [m].
+    cluster_eps: float = 0.012  # DBSCAN neighbourhood radius [m].
+    cluster_min_points: int = 4  # DBSCAN core-point neighbour count (voxels).
+    min_cluster_points: int = 40  # smaller clusters are noise (voxels).
+    border_margin_px: int = 2  # a cluster with a pixel this close to the image edge is cut [px].
+    drop_border_objects: bool = True  # drop objects cut by the image border (else keep them).
+    seed: int = 0  # RANSAC random seed.
+
+
+@dataclass
+class CompletionConfig:
+    """Symmetry-based shape completion (paper III-A) and the circle test for handles (III-B)."""
+
+    sigma: float = 0.9  # top region: points with height above σ·d_z (paper's σ ∈ [0, 1]).
+    normal_neighbours: int = 12  # k of the k-nn normal estimate.
+    circle_bins: int = 36  # angular bins of the outline over 360° (folded to 180°).
+    circle_tolerance: float = 0.08  # outline radius within ±this share of R is on the circle.
+    min_circle_fraction: float = 0.85  # share of non-handle outline bins on the circle.
+    min_circle_coverage: float = 0.9  # share of folded outline bins that must hold points.
+    handle_min_protrusion: float = 0.2  # a handle reaches at least (1 + this)·R from the axis.
+    max_handle_fraction: float = 0.45  # a handle covers at most this share of the folded outline.
+    min_handle_points: int = 8  # fewer points outside the circle are noise, not a handle.
+
+
+@dataclass
+class PoseConfig:
+    """Upright / sideways / upside-down and its likelihood (see `tg_drake.perception.pose`)."""
+
+    cavity_depth: float = 0.01  # a cavity point lies this far below the rim, at least [m] ...
+    cavity_depth_fraction: float = 0.12  # ... or this share of the object height if larger.
+    min_cavity_share: float = 0.25  # share of far-side points inside the rim that are deep.
+    min_cavity_points: int = 6  # at least this many deep points make a cavity.
+    neck_ratio: float = 0.6  # top radius below this share of the base radius is a neck.
+    taper_ratio: float = 0.92  # top radius below this share of the base radius is a taper.
+
+
+@dataclass
+class PartConfig:
+    """Semantic parts (paper III-B)."""
+
+    tool_max_thickness: float = 0.045  # a lying object thinner than this across is a tool [m].
+    top_fraction: float = 1.0 / 3.0  # share of the axis length labelled top.
+    bottom_fraction: float = 1.0 / 3.0  # share of the axis length labelled bottom.
+    profile_bins: int = 30  # bins along the axis for the tool's cross-section profile.
+    coverage_bins: int = 5  # bins per part for the visible-coverage part probability.
+
+
+@dataclass
+class PregraspConfig:
+    """Pre-grasp hypotheses: two gripper poses per face of each part box (paper III-B)."""
+
+    grasp_depth: float = 0.02  # the grasp point lies this far inside the face [m] (at most
+    # half the box depth): the fingers straddle the part's outer layer.
+
+
+@dataclass
+class PerceptionConfig:
+    segmentation: SegmentationConfig = field(default_factory=SegmentationConfig)
+    completion: CompletionConfig = field(default_factory=CompletionConfig)
+    pose: PoseConfig = field(default_factory=PoseConfig)
+    parts: PartConfig = field(default_factory=PartConfig)
+    pregrasp: PregraspConfig = field(default_factory=PregraspConfig)

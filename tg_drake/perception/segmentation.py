@@ -1,0 +1,171 @@
+"""Table plane and object clusters from a depth cloud (the paper's table-top segmentation step).
+
+The table is the largest horizontal plane found by RANSAC (Open3D `segment_plane`), refitted by
+least squares on its inliers. The table frame T has its origin at the inliers' centroid on the
+plane, z along the plane normal (towards the camera, i.e. up) and x along the inliers' principal
+direction. Object points are the points above the plane, inside the table's extent; they are
+averaged per voxel and clustered with DBSCAN (Open3D `cluster_dbscan`). A cluster with a pixel on
+the image border is cut: by default it is dropped, since no completion can recover what the
+image does not hold.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import open3d as o3d
+
+from tg_drake.errors import PerceptionError
+from tg_drake.perception.config import SegmentationConfig
+from tg_drake.perception.geometry import (
+    Intrinsics,
+    depth_to_points,
+    dot3,
+    inverse,
+    make_transform,
+    transform,
+    voxel_average,
+)
+
+# Fewer valid pixels than this cannot hold a table and an object.
+MIN_CLOUD_POINTS = 100
+
+
+@dataclass
+class Segmentation:
+    """The table and the object clusters of one depth frame."""
+
+    X_WT: np.ndarray  # 4×4 table frame: origin on the table top, z along its normal.
+    table_min_T: np.ndarray  # (2,) lower corner of the table's extent in T (x, y) [m].
+    table_max_T: np.ndarray  # (2,) upper corner [m].
+    objects_T: list[np.ndarray]  # per object, (M, 3) voxel-averaged points in T [m].
+    cut: list[bool]  # per object, True when it touches the image border (kept only when
+    # drop_border_objects is False).
+    n_dropped_cut: int = 0  # objects dropped because they touch the image border.
+    n_points: int = 0  # valid points in the frame.
+    plane_tilts_deg: list[float] = field(default_factory=list)  # tilt of every plane tried.
+
+
+def _fit_plane(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares plane through points: (centroid, unit normal)."""
+    c = p.mean(axis=0)
+    _, _, vt = np.linalg.svd(p - c, full_matrices=False)
+    return c, vt[2]
+
+
+def find_table(p_W: np.ndarray, p_WC: np.ndarray, cfg: SegmentationConfig
+               ) -> tuple[np.ndarray, np.ndarray, list[float]]:
+    """The table plane of a world-frame cloud.
+
+    Returns the plane point c_W, its unit normal n_W (towards the camera) and the tilt of every
+    plane tried [deg]. Raises PerceptionError when no horizontal plane holds enough points.
+    """
+    o3d.utility.random.seed(cfg.seed)
+    remaining = p_W
+    tilts = []
+    cos_max = np.cos(np.radians(cfg.max_table_tilt_deg))
+    need = cfg.min_table_fraction * len(p_W)
+    for _ in range(cfg.max_planes):
+        if len(remaining) < max(3, need):
+            break
+        stride = max(1, len(remaining) // cfg.ransac_points)
+        sub = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(remaining[::stride]))
+        (a, b, c, d), _ = sub.segment_plane(cfg.plane_distance, 3, cfg.ransac_iterations)
+        n = np.array([a, b, c])
+        scale = np.linalg.norm(n)
+        n, d = n / scale, d / scale
+        if n @ p_WC + d < 0:  # point the normal to the camera's side.
+            n, d = -n, -d
+        inliers = np.abs(dot3(remaining, n) + d) < cfg.plane_distance
+        tilts.append(float(np.degrees(np.arccos(np.clip(n[2], -1.0, 1.0)))))
+        if n[2] >= cos_max and inliers.sum() >= need:
+            stride = max(1, int(inliers.sum()) // cfg.ransac_points)
+            c_W, n_W = _fit_plane(remaining[inliers][::stride])
+            if n_W @ (p_WC - c_W) < 0:
+                n_W = -n_W
+            return c_W, n_W, tilts
+        remaining = remaining[~inliers]
+    tried = ", ".join(f"{t:.0f}°" for t in tilts) or "none"
+    raise PerceptionError(
+        f"no table plane: no plane within {cfg.max_table_tilt_deg:g}° of horizontal holds "
+        f"{cfg.min_table_fraction:.0%} of the {len(p_W)} points (planes tried, tilt: {tried})")
+
+
+def segment_cloud(p_W: np.ndarray, pixels: np.ndarray, image_size: tuple[int, int],
+                  p_WC: np.ndarray, cfg: SegmentationConfig | None = None) -> Segmentation:
+    """Table and object clusters of a world-frame cloud whose points came from image pixels.
+
+    Args:
+        p_W: (N, 3) points in the world frame [m].
+        pixels: (N, 2) (row, column) of each point.
+        image_size: (width, height) of the image [px].
+        p_WC: (3,) camera position in the world [m].
+        cfg: segmentation parameters.
+    """
+    cfg = cfg or SegmentationConfig()
+    if len(p_W) < MIN_CLOUD_POINTS:
+        raise PerceptionError(
+            f"empty cloud: the depth image has {len(p_W)} valid pixels (need at least "
+            f"{MIN_CLOUD_POINTS}); every pixel is 0 (too close) or +inf (too far)")
+    c_W, n_W, tilts = find_table(p_W, p_WC, cfg)
+
+    # Table frame: z = normal, x = principal direction of the plane inliers (sign: world +x).
+    height = dot3(p_W, n_W) - c_W @ n_W
+    on_table = np.flatnonzero(np.abs(height) < cfg.plane_distance)
+    table = p_W[on_table[:: max(1, len(on_table) // cfg.ransac_points)]]
+    flat = (table - c_W) - np.outer(dot3(table - c_W, n_W), n_W)
+    _, _, vt = np.linalg.svd(flat, full_matrices=False)
+    x = vt[0] - (vt[0] @ n_W) * n_W
+    x = x / np.linalg.norm(x)
+    if x[0] < 0 or (x[0] == 0 and x[1] < 0):
+        x = -x
+    X_WT = make_transform(np.column_stack([x, np.cross(n_W, x), n_W]), c_W)
+    X_TW = inverse(X_WT)
+    table_T = transform(X_TW, table)
+    # 0.5 % / 99.5 %: the extent ignores stray inliers of other coplanar surfaces.
+    lo = np.percentile(table_T[:, :2], 0.5, axis=0) - cfg.table_margin
+    hi = np.percentile(table_T[:, :2], 99.5, axis=0) + cfg.table_margin
+
+    # Object points: above the plane, over the table.
+    above = np.flatnonzero((height > cfg.min_object_height) & (height < cfg.max_object_height))
+    p_T = transform(X_TW, p_W[above])
+    inside = np.all(p_T[:, :2] >= lo, axis=1) & np.all(p_T[:, :2] <= hi, axis=1)
+    p_T, above = p_T[inside], above[inside]
+    width, height_px = image_size
+    m = cfg.border_margin_px
+    r, c = pixels[above, 0], pixels[above, 1]
+    border = (r < m) | (c < m) | (r >= height_px - m) | (c >= width - m)
+    objects: list[np.ndarray] = []
+    cut: list[bool] = []
+    n_dropped = 0
+    if len(p_T) >= cfg.min_cluster_points:
+        q, voxel = voxel_average(p_T, cfg.voxel_size)
+        voxel_cut = np.bincount(voxel, weights=border, minlength=len(q)) > 0
+        labels = np.asarray(o3d.geometry.PointCloud(o3d.utility.Vector3dVector(q)).cluster_dbscan(
+            cfg.cluster_eps, cfg.cluster_min_points))
+        sizes = np.bincount(labels[labels >= 0]) if (labels >= 0).any() else np.zeros(0, int)
+        big = np.flatnonzero(sizes >= cfg.min_cluster_points)
+        # Deterministic order: by the cluster's centroid x, then y, in the table frame.
+        centroids = np.array([q[labels == k].mean(axis=0) for k in big]).reshape(-1, 3)
+        for k in big[np.lexsort((centroids[:, 1], centroids[:, 0]))]:
+            members = labels == k
+            is_cut = bool(voxel_cut[members].any())
+            if is_cut and cfg.drop_border_objects:
+                n_dropped += 1
+                continue
+            objects.append(q[members])
+            cut.append(is_cut)
+    if not objects and n_dropped:
+        raise PerceptionError(
+            f"every object on the table ({n_dropped}) is cut by the image border; move the "
+            f"camera so the objects are whole in the image, or set drop_border_objects=False")
+    return Segmentation(X_WT, lo, hi, objects, cut, n_dropped, len(p_W), tilts)
+
+
+def segment_depth(depth: np.ndarray, intrinsics: Intrinsics, X_WC: np.ndarray,
+                  cfg: SegmentationConfig | None = None) -> Segmentation:
+    """Table and object clusters of a depth image seen from camera pose X_WC."""
+    p_W, pixels = depth_to_points(depth, intrinsics, X_WC)
+    return segment_cloud(p_W, pixels, (intrinsics.width, intrinsics.height),
+                         np.asarray(X_WC, float)[:3, 3], cfg)
