@@ -1,0 +1,392 @@
+"""Observations about one object, as data for the theory (paper IV-A).
+
+`Observations` holds what perception, the kernel prior, the user and the planner say about the
+object under query: probabilistic parts, the pose likelihood, containment, the category prior (an
+annotated disjunction, or uniform), the given task or a task prior, and collision(Part) evidence.
+It is validated on construction; bad input raises `RuleError` naming the field and the allowed
+values.
+
+The observations enter the theory in two ways, and both are built here from ProbLog terms, never
+from strings:
+
+- `observation_schema()`: the *structure*, every perception-driven atom declared as a
+  probabilistic fact (annotated disjunctions broken into chains of independent facts), with
+  `parameters(obs)` giving their weights for one scene. The compiled theory is ground once on the
+  schema and only re-weighted per scene (tg_drake/logic/engine.py).
+- `observation_clauses(obs)`: the scene as a plain ProbLog program (facts and annotated
+  disjunctions with the scene's probabilities) for the reference path that re-grounds per query.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from problog.logic import AnnotatedDisjunction, Clause, Constant, Not, Term
+
+from tg_drake.errors import RuleError, unknown_name
+from tg_drake.logic.names import OBJECT, TASK_ATOMS
+from tg_drake.types import (
+    CATEGORIES,
+    CONTAINMENTS,
+    PART_LABELS,
+    POSES,
+    TASKS,
+    CategoryDistribution,
+    ObjectDescription,
+    part_index,
+)
+
+# A sum of probabilities may exceed 1 by this much and still be a distribution: float rounding of
+# numbers that were normalised elsewhere (e.g. the kernel prior) is ~1e-15; a user's file written
+# with two decimals is exact. Above it, the input is not a distribution.
+SUM_TOLERANCE = 1e-6
+
+
+@dataclass
+class Observations:
+    """What is known about the object under query (the constant ``o`` in the theory)."""
+
+    parts: dict[str, float]  # PART_LABELS entry → probability the part is there (missing: 0).
+    pose: dict[str, float] = field(default_factory=dict)
+    # POSES entry → likelihood; sums to at most 1, the rest is "pose unknown".
+    containment: dict[str, float] | None = None
+    # CONTAINMENTS entry → probability (sums to at most 1); None: unknown, i.e. 0.5 each.
+    category_prior: dict[str, float] | None = None
+    # CATEGORIES entry → probability (an annotated disjunction, sum ≤ 1); None: uniform 1/11.
+    task: str | None = None  # the given TASKS entry, or None to infer the task.
+    task_prior: dict[str, float] | None = None
+    # TASKS entry → probability when the task is inferred (sum ≤ 1, > 0); None: uniform 1/7.
+    collisions: tuple[str, ...] = ()  # parts the gripper cannot reach: collision(Part) evidence.
+    handles: int = 1  # handles seen when the handle part is there: 1, or 2 (a pot's pair).
+    source: str | None = None  # the file these came from, for error messages.
+
+    def __post_init__(self):
+        self.parts = _distribution(self.parts, PART_LABELS, "parts", "part", self.source,
+                                   exclusive=False)
+        self.pose = _distribution(self.pose or {}, POSES, "pose", "pose", self.source)
+        if self.containment is not None:
+            self.containment = _distribution(self.containment, CONTAINMENTS, "containment",
+                                             "containment", self.source)
+        if self.category_prior is not None:
+            self.category_prior = _distribution(self.category_prior, CATEGORIES,
+                                                "category_prior", "category", self.source)
+            if sum(self.category_prior.values()) <= 0.0:
+                raise RuleError("the category prior is all zero (evidence of probability 0); "
+                                "give a distribution or leave it out for a uniform prior",
+                                file=self.source, field="category_prior")
+        if self.task is not None:
+            if self.task not in TASKS:
+                raise unknown_name("task", self.task, TASKS, error=RuleError, file=self.source,
+                                   field="task")
+            if self.task_prior is not None:
+                raise RuleError("give either a task or a task prior, not both",
+                                file=self.source, field="task_prior")
+        if self.task_prior is not None:
+            self.task_prior = _distribution(self.task_prior, TASKS, "task_prior", "task",
+                                            self.source)
+            if sum(self.task_prior.values()) <= 0.0:
+                raise RuleError("the task prior is all zero (evidence of probability 0)",
+                                file=self.source, field="task_prior")
+        collisions = (self.collisions,) if isinstance(self.collisions, str) else self.collisions
+        for name in collisions:
+            if name not in PART_LABELS:
+                raise unknown_name("part", name, PART_LABELS, error=RuleError, file=self.source,
+                                   field="collisions")
+        self.collisions = tuple(dict.fromkeys(collisions))
+        if self.handles not in (1, 2):
+            raise RuleError(f"handles must be 1 or 2, got {self.handles!r}", file=self.source,
+                            field="handles")
+
+    # ---- as weights of the compiled schema -------------------------------------------------
+
+    def parameters(self) -> np.ndarray:
+        """The weights of the schema's probabilistic facts for this scene, in SCHEMA_PARAMETERS
+        order (annotated disjunctions as the conditional weights of their fact chains)."""
+        return np.concatenate([
+            _vector(self.parts, PART_LABELS),
+            stick_breaking(_vector(self.pose, POSES)),
+            stick_breaking(self.containment_vector()),
+            stick_breaking(self.category_vector()),
+            stick_breaking(self.task_vector()),
+            np.array([float(p in self.collisions) for p in PART_LABELS]),
+            np.array([float(self.handles == 2)]),
+        ])
+
+    def containment_vector(self) -> np.ndarray:
+        if self.containment is None:  # unknown: either is as likely.
+            return np.full(len(CONTAINMENTS), 1.0 / len(CONTAINMENTS))
+        return _vector(self.containment, CONTAINMENTS)
+
+    def category_vector(self) -> np.ndarray:
+        if self.category_prior is None:
+            return np.full(len(CATEGORIES), 1.0 / len(CATEGORIES))
+        return _vector(self.category_prior, CATEGORIES)
+
+    def task_vector(self) -> np.ndarray:
+        if self.task is not None:
+            return np.array([float(t == self.task) for t in TASKS])
+        if self.task_prior is None:
+            return np.full(len(TASKS), 1.0 / len(TASKS))
+        return _vector(self.task_prior, TASKS)
+
+    # ---- constructors ----------------------------------------------------------------------
+
+    @classmethod
+    def from_dict(cls, data: dict, *, source: str | None = None) -> Observations:
+        """From a parsed observations file (see rules/examples/fig1_cup.yaml)."""
+        if not isinstance(data, dict):
+            raise RuleError("an observations file holds a mapping of fields", file=source)
+        allowed = ("parts", "pose", "containment", "category_prior", "task", "task_prior",
+                   "collisions", "handles")
+        for key in data:
+            if key not in allowed:
+                raise unknown_name("field", key, allowed, error=RuleError, file=source,
+                                   field=str(key))
+        if "parts" not in data:
+            raise RuleError("missing field; it maps part names to probabilities",
+                            file=source, field="parts")
+        for key in ("parts", "pose", "category_prior", "task_prior"):
+            if data.get(key) is not None and not isinstance(data[key], dict):
+                raise RuleError("expected a mapping of names to probabilities", file=source,
+                                field=key)
+        containment = data.get("containment")
+        if isinstance(containment, str):
+            if containment not in CONTAINMENTS:
+                raise unknown_name("containment", containment, CONTAINMENTS, error=RuleError,
+                                   file=source, field="containment")
+            containment = {containment: 1.0}
+        elif containment is not None and not isinstance(containment, dict):
+            raise RuleError("expected empty, full, or a mapping of them to probabilities",
+                            file=source, field="containment")
+        collisions = data.get("collisions") or ()
+        if not isinstance(collisions, list | tuple | str):
+            raise RuleError("expected a list of part names", file=source, field="collisions")
+        handles = data.get("handles", 1)
+        if isinstance(handles, bool) or not isinstance(handles, int):
+            raise RuleError(f"handles must be 1 or 2, got {handles!r}", file=source,
+                            field="handles")
+        task = data.get("task")
+        if task is not None and not isinstance(task, str):
+            raise RuleError(f"expected a task name, got {task!r}", file=source, field="task")
+        return cls(parts=data["parts"], pose=data.get("pose") or {}, containment=containment,
+                   category_prior=data.get("category_prior"), task=task,
+                   task_prior=data.get("task_prior"),
+                   collisions=tuple(collisions) if not isinstance(collisions, str)
+                   else (collisions,), handles=handles, source=source)
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> Observations:
+        """From a YAML observations file; a malformed file raises RuleError naming it."""
+        import yaml
+
+        path = Path(path)
+        try:
+            data = yaml.safe_load(path.read_text())
+        except OSError as e:
+            raise RuleError(f"cannot read observations: {e.strerror}", file=str(path)) from None
+        except yaml.YAMLError as e:
+            mark = getattr(e, "problem_mark", None)
+            raise RuleError(f"not valid YAML: {getattr(e, 'problem', e)}", file=str(path),
+                            line=mark.line + 1 if mark is not None else None) from None
+        return cls.from_dict(data, source=str(path))
+
+    @classmethod
+    def from_object(cls, obj: ObjectDescription, *,
+                    prior: CategoryDistribution | None = None, task: str | None = None,
+                    collisions: tuple[str, ...] = ()) -> Observations:
+        """From perception's description of one object, the kernel prior (None: uniform), the
+        task ("" or None: infer it) and the parts the planner could not reach."""
+        category_prior = None
+        if prior is not None:
+            p = np.asarray(prior.probabilities, dtype=float)
+            if p.shape != (len(CATEGORIES),):
+                raise RuleError(f"a category prior has {len(CATEGORIES)} entries, one per "
+                                f"category ({', '.join(CATEGORIES)}); got shape {p.shape}",
+                                field="category_prior")
+            category_prior = dict(zip(CATEGORIES, p.tolist()))
+        return cls(parts=dict(obj.part_probabilities), pose=dict(obj.pose_likelihood),
+                   containment=None if obj.containment is None else {obj.containment: 1.0},
+                   category_prior=category_prior, task=task or None,
+                   collisions=tuple(collisions), handles=count_handles(obj))
+
+
+def count_handles(obj: ObjectDescription) -> int:
+    """1 or 2: whether the handle points sit on one side of the symmetry axis or on two opposite
+    sides (a pot's pair of handles).
+
+    The directions from the object's z axis to the handle points, in the object's xy plane, are
+    averaged as unit vectors: one handle gives a mean resultant length near 1, two opposite
+    handles near 0. The split at 0.5 is where a second, equal cluster at more than 120° from the
+    first would pull the mean below it.
+    """
+    handle = np.asarray(obj.labels) == part_index("handle")
+    if not handle.any():
+        return 1
+    X_WO = np.asarray(obj.X_WO, dtype=float)
+    p_O = (np.asarray(obj.p_W, dtype=float)[handle] - X_WO[:3, 3]) @ X_WO[:3, :3]
+    d = p_O[:, :2]
+    norm = np.linalg.norm(d, axis=1)
+    d = d[norm > 0] / norm[norm > 0, None]
+    if len(d) == 0:
+        return 1
+    return 2 if np.linalg.norm(d.mean(axis=0)) < 0.5 else 1
+
+
+def _distribution(values, names, field_name, kind, source, *, exclusive=True) -> dict[str, float]:
+    if not isinstance(values, dict):
+        raise RuleError("expected a mapping of names to probabilities", file=source,
+                        field=field_name)
+    out = {}
+    for name, p in values.items():
+        if name not in names:
+            raise unknown_name(kind, name, names, error=RuleError, file=source,
+                               field=f"{field_name}.{name}")
+        if isinstance(p, bool) or not isinstance(p, int | float) or not math.isfinite(p) \
+                or not 0.0 <= p <= 1.0:
+            raise RuleError(f"probability of {name!r} must be a number in [0, 1], got {p!r}",
+                            file=source, field=f"{field_name}.{name}")
+        out[name] = float(p)
+    total = sum(out.values())
+    if exclusive and total > 1.0 + SUM_TOLERANCE:
+        raise RuleError(f"the outcomes are mutually exclusive, so their probabilities sum to at "
+                        f"most 1; got {total:.6g}", file=source, field=field_name)
+    return out
+
+
+def _vector(values: dict[str, float], names) -> np.ndarray:
+    return np.array([values.get(n, 0.0) for n in names])
+
+
+def stick_breaking(p: np.ndarray) -> np.ndarray:
+    """The weights q of a chain of independent facts c_1..c_n that encodes an annotated
+    disjunction with probabilities p: outcome i is (not c_1, ..., not c_{i-1}, c_i), so
+    q_i = p_i / (1 - p_1 - ... - p_{i-1}). A remainder of 0 makes the later weights 0."""
+    p = np.asarray(p, dtype=float)
+    rest = 1.0 - np.concatenate([[0.0], np.cumsum(p)[:-1]])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = np.where(rest > 1e-15, p / np.where(rest > 1e-15, rest, 1.0), 0.0)
+    return np.clip(q, 0.0, 1.0)
+
+
+# ---- the schema: every perception-driven atom as a probabilistic fact --------------------------
+
+def _o() -> Term:
+    return Term(OBJECT)
+
+
+def _ad_groups():
+    """(parameter group, head atoms, body) for each annotated disjunction of the observations."""
+    o = _o()
+    return [
+        ("pose", [Term("pose", o, Term(p)) for p in POSES], None),
+        ("containment", [Term(c, o) for c in CONTAINMENTS], None),
+        ("prior", [Term("cat", o, Term(c)) for c in CATEGORIES], Term("object", o)),
+        ("task", [Term("task", Term(TASK_ATOMS[t])) for t in TASKS], None),
+    ]
+
+
+# Parameter rows of the schema, in the order of Observations.parameters().
+SCHEMA_PARAMETERS: tuple[tuple[str, str], ...] = (
+    tuple(("part", p) for p in PART_LABELS)
+    + tuple(("pose", p) for p in POSES)
+    + tuple(("containment", c) for c in CONTAINMENTS)
+    + tuple(("prior", c) for c in CATEGORIES)
+    + tuple(("task", t) for t in TASKS)
+    + tuple(("collision", p) for p in PART_LABELS)
+    + (("handles", "pair"),)
+)
+
+# The placeholder weight of schema facts while grounding: anything strictly inside (0, 1) keeps a
+# fact a variable (ProbLog folds 0 and 1 into constants).
+PLACEHOLDER = 0.5
+
+
+def observation_schema() -> tuple[list[Term], dict[Term, int]]:
+    """The observation structure as ProbLog clauses, and for each schema fact the row of
+    `Observations.parameters()` that weighs it."""
+    o = _o()
+    clauses: list[Term] = [Term("object", o)]
+    rows: dict[Term, int] = {}
+    index = {key: i for i, key in enumerate(SCHEMA_PARAMETERS)}
+    for part in PART_LABELS:
+        fact = Term("part", Term(part), o)
+        clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
+        rows[fact] = index[("part", part)]
+    for group, heads, body in _ad_groups():
+        names = [key[1] for key in SCHEMA_PARAMETERS if key[0] == group]
+        for i, head in enumerate(heads):
+            choice = Term(f"obs_{group}", Constant(i))
+            clauses.append(choice.with_probability(Constant(PLACEHOLDER)))
+            rows[choice] = index[(group, names[i])]
+            literals = ([body] if body is not None else []) + [
+                Not("\\+", Term(f"obs_{group}", Constant(j))) for j in range(i)] + [choice]
+            clauses.append(Clause(head, _conjunction(literals)))
+    for part in PART_LABELS:
+        fact = Term("collision", Term(part))
+        clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
+        rows[fact] = index[("collision", part)]
+    fact = Term("handle_pair", o)
+    clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
+    rows[fact] = index[("handles", "pair")]
+    return clauses, rows
+
+
+def observation_clauses(obs: Observations) -> list[Term]:
+    """The scene as a plain ProbLog program: facts with their probabilities and the annotated
+    disjunctions themselves (the paper's form, e.g. 0.56::cup(o); 0.36::can(o); ... <- object(o))."""
+    o = _o()
+    clauses: list[Term] = [Term("object", o)]
+
+    def fact(term: Term, p: float):
+        if p >= 1.0:
+            clauses.append(term)
+        elif p > 0.0:
+            clauses.append(term.with_probability(Constant(p)))
+
+    for part in PART_LABELS:
+        fact(Term("part", Term(part), o), obs.parts.get(part, 0.0))
+    vectors = {"pose": _vector(obs.pose, POSES), "containment": obs.containment_vector(),
+               "prior": obs.category_vector(), "task": obs.task_vector()}
+    for group, heads, body in _ad_groups():
+        p = vectors[group]
+        kept = [h.with_probability(Constant(float(pi))) for h, pi in zip(heads, p) if pi > 0]
+        if kept:
+            clauses.append(AnnotatedDisjunction(kept, body if body is not None else Term("true")))
+    for part in obs.collisions:
+        clauses.append(Term("collision", Term(part)))
+    if obs.handles == 2:
+        clauses.append(Term("handle_pair", o))
+    # An observation predicate with no clause in this scene (no collision, no pose, ...) is
+    # defined as failing, so that ProbLog does not reject the theory's calls to it.
+    defined = {_head(c).signature for c in clauses}
+    for head in _schema_heads():
+        if head.signature not in defined:
+            clauses.append(Clause(head, Term("fail")))
+            defined.add(head.signature)
+    return clauses
+
+
+def _head(clause: Term) -> Term:
+    if isinstance(clause, AnnotatedDisjunction):
+        return clause.heads[0]
+    if isinstance(clause, Clause):
+        return clause.head
+    return clause
+
+
+def _schema_heads() -> list[Term]:
+    o = _o()
+    heads = [Term("part", Term(PART_LABELS[0]), o), Term("collision", Term(PART_LABELS[0])),
+             Term("handle_pair", o)]
+    for _, group_heads, _ in _ad_groups():
+        heads.extend(group_heads)
+    return heads
+
+
+def _conjunction(literals: list[Term]) -> Term:
+    from problog.logic import And
+
+    return And.from_list(literals)
