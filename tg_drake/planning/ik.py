@@ -1,8 +1,10 @@
 """Inverse kinematics for the iiwa + WSG: joint positions that put the gripper frame G at a pose.
 
 The arm model for planning is a separate plant (`make_arm_plant`): the iiwa, the WSG welded to its
-flange with its fingers fixed open, the table, and optional obstacles (boxes) welded where the
-perceived objects are. Collision avoidance uses minimum-distance constraints on that plant.
+flange with its fingers fixed open, the table, optional obstacles (boxes) welded where the
+perceived objects are, and optionally a held object (a box welded to the gripper frame G).
+Collision avoidance uses minimum-distance constraints on that plant; `clearance` measures the
+smallest signed distance of a configuration for checking a path after it is planned.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.parsing import ModelDirectives, ProcessModelDirectives
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction
 from pydrake.multibody.tree import SpatialInertia
-from pydrake.solvers import Solve
+from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 from pydrake.systems.framework import DiagramBuilder
 
 from tg_drake.scenario import IIWA_HOME, Scenario, default_directives
@@ -32,13 +34,27 @@ class ArmPlant:
     G: object  # the WSG body frame
     iiwa: object  # model instance
     obstacles: list  # (name, X_WB, size) boxes added as obstacles
+    iiwa_indices: np.ndarray = None  # (7,) positions of the iiwa joints in the plant's q
+    q_fingers: np.ndarray = None  # (nq,) plant positions with the fingers at the opening (iiwa 0)
+
+    def full_q(self, q_iiwa) -> np.ndarray:
+        """The plant's position vector for iiwa joint positions `q_iiwa` (fingers as held)."""
+        q = self.q_fingers.copy()
+        q[self.iiwa_indices] = q_iiwa
+        return q
 
 
 def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
-                   finger_opening: float = 0.11) -> ArmPlant:
+                   finger_opening: float = 0.11, held=None, finger_contact=()) -> ArmPlant:
     """A kinematic model of the arm for IK and collision checking.
 
     obstacles: iterable of (name, X_WB RigidTransform, (sx, sy, sz)) boxes welded to the world.
+    held: None, or (X_GO RigidTransform, (sx, sy, sz)): a box carried in the hand, welded to the
+        gripper frame G. It never collides with the gripper or links 6–7 (it is in the hand), and
+        it does collide with the rest of the arm, the table and the obstacles.
+    finger_contact: names of obstacles the two finger pads may overlap (the object being grasped
+        or released: its box is a bounding box, and the fingers close on the object inside it);
+        the rest of the arm and gripper still keeps clear of them.
     """
     from tg_drake.station import make_parser
 
@@ -55,6 +71,7 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
     # Fix the fingers at the given opening: weld-like by locking their joints in IK (bounds).
     world = plant.world_body()
     added = []
+    touchable = []
     for name, X_WB, size in obstacles:
         instance = plant.AddModelInstance(f"obstacle_{name}")
         body = plant.AddRigidBody(f"obstacle_{name}", instance,
@@ -63,6 +80,22 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
                                         CoulombFriction(0.5, 0.5))
         plant.WeldFrames(world.body_frame(), body.body_frame(), X_WB)
         added.append((name, X_WB, size))
+        if name in finger_contact:
+            touchable.append(body)
+    unknown = set(finger_contact) - {name for name, _, _ in added}
+    if unknown:
+        raise ValueError(f"finger_contact names unknown obstacle(s) {sorted(unknown)}; "
+                         f"obstacles: {', '.join(name for name, _, _ in added)}")
+    held_body = None
+    if held is not None:
+        X_GO, size = held
+        instance = plant.AddModelInstance("held_object")
+        held_body = plant.AddRigidBody("held_object", instance,
+                                       SpatialInertia.SolidBoxWithMass(1.0, *size))
+        plant.RegisterCollisionGeometry(held_body, RigidTransform(), Box(*size), "held_object",
+                                        CoulombFriction(0.5, 0.5))
+        plant.WeldFrames(plant.GetFrameByName("body", plant.GetModelInstanceByName("wsg")),
+                         held_body.body_frame(), X_GO)
     plant.Finalize()
     # The gripper's own bodies never collide with each other or with link 7 (they are attached).
     wsg = plant.GetModelInstanceByName("wsg")
@@ -72,14 +105,34 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
         [g for b in plant.GetBodyIndices(wsg)
          for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))]
         + list(plant.GetCollisionGeometriesForBody(plant.GetBodyByName("iiwa_link_7", iiwa)))
-        + list(plant.GetCollisionGeometriesForBody(plant.GetBodyByName("iiwa_link_6", iiwa))))
+        + list(plant.GetCollisionGeometriesForBody(plant.GetBodyByName("iiwa_link_6", iiwa)))
+        + (list(plant.GetCollisionGeometriesForBody(held_body)) if held_body else []))
     manager.Apply(CollisionFilterDeclaration().ExcludeWithin(gripper_geometries))
+    if touchable:
+        fingers = GeometrySet([g for n in ("left_finger", "right_finger")
+                               for g in plant.GetCollisionGeometriesForBody(
+                                   plant.GetBodyByName(n, wsg))])
+        objects = GeometrySet([g for b in touchable for g in plant.GetCollisionGeometriesForBody(b)])
+        manager.Apply(CollisionFilterDeclaration().ExcludeBetween(fingers, objects))
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     plant_context = plant.GetMyMutableContextFromRoot(context)
     plant.SetPositions(plant_context, wsg, [-finger_opening / 2, finger_opening / 2])
     G = plant.GetFrameByName("body", wsg)
-    return ArmPlant(diagram, plant, scene_graph, context, plant_context, G, iiwa, added)
+    iiwa_indices = np.array([plant.GetJointByName(f"iiwa_joint_{k + 1}", iiwa).position_start()
+                             for k in range(7)])
+    return ArmPlant(diagram, plant, scene_graph, context, plant_context, G, iiwa, added,
+                    iiwa_indices, plant.GetPositions(plant_context).copy())
+
+
+def clearance(arm: ArmPlant, q_iiwa, max_distance: float = 0.1) -> float:
+    """The smallest signed distance [m] between unfiltered collision geometries of the arm plant
+    at iiwa joint positions `q_iiwa` (negative: penetration); `max_distance` when every pair is
+    farther apart than that."""
+    arm.plant.SetPositions(arm.plant_context, arm.full_q(q_iiwa))
+    query = arm.plant.get_geometry_query_input_port().Eval(arm.plant_context)
+    pairs = query.ComputeSignedDistancePairwiseClosestPoints(max_distance)
+    return min([max_distance] + [pair.distance for pair in pairs])
 
 
 @dataclass
@@ -92,11 +145,15 @@ class IkResult:
 
 def solve_ik(arm: ArmPlant, X_WG: RigidTransform, *, q_seed=IIWA_HOME,
              position_tolerance: float = 0.002, angle_tolerance: float = 0.02,
-             min_distance: float | None = 0.005) -> IkResult:
+             min_distance: float | None = 0.005, max_iterations: int = 100,
+             q_guess=None) -> IkResult:
     """Joint positions putting G at X_WG within tolerances, inside joint limits and (when
     `min_distance` is given) with every collision pair at least that far apart.
 
     position_tolerance [m] and angle_tolerance [rad] bound the gripper's pose error.
+    max_iterations bounds SNOPT's major iterations: a solvable IK converges in a few tens, and an
+    unsolvable one with collision constraints can otherwise take a second to give up.
+    q_guess: the solver's initial guess (default: q_seed); the cost always pulls towards q_seed.
     """
     plant = arm.plant
     ik = InverseKinematics(plant, arm.plant_context, with_joint_limits=True)
@@ -119,14 +176,71 @@ def solve_ik(arm: ArmPlant, X_WG: RigidTransform, *, q_seed=IIWA_HOME,
     iiwa_idx = [plant.GetJointByName(f"iiwa_joint_{k + 1}", arm.iiwa).position_start()
                 for k in range(7)]
     q_nominal = q_all.copy()
-    q_nominal[iiwa_idx] = q_seed
+    q_nominal[iiwa_idx] = q_seed if q_guess is None else q_guess
     prog.AddQuadraticErrorCost(np.eye(len(iiwa_idx)) * 0.01, np.asarray(q_seed), q[iiwa_idx])
     prog.SetInitialGuess(q, q_nominal)
-    result = Solve(prog)
+    options = SolverOptions()
+    options.SetOption(SnoptSolver().solver_id(), "Major iterations limit", max_iterations)
+    result = Solve(prog, solver_options=options)
     q_sol = result.GetSolution(q)
     plant.SetPositions(arm.plant_context, q_sol)
     err = float(np.linalg.norm(arm.G.CalcPoseInWorld(arm.plant_context).translation() - p))
-    if not result.is_success():
+    if not satisfies_constraints(result, prog):
         return IkResult(False, q_sol[iiwa_idx], err,
-                        f"no inverse-kinematics solution ({result.get_solver_id().name()})")
+                        f"no inverse-kinematics solution ({result.get_solver_id().name()}: "
+                        f"{result.get_solution_result().name})")
     return IkResult(True, q_sol[iiwa_idx], err)
+
+
+# [constraint units: rad, m, and the minimum-distance penalty] SNOPT's default feasibility
+# tolerance is 1e-6; we accept a little more than that.
+CONSTRAINT_TOLERANCE = 1e-5
+
+
+def satisfies_constraints(result, prog, tolerance: float = CONSTRAINT_TOLERANCE) -> bool:
+    """Whether the solver's answer satisfies every constraint of `prog`.
+
+    The costs only express a preference (stay near the seed; be fast), so an answer that SNOPT
+    could not prove optimal ("current point cannot be improved") is still a valid solution when
+    it is feasible; an infeasible answer fails this check whatever the solver said."""
+    if result.is_success():
+        return True
+    x = result.get_x_val()
+    return all(b.evaluator().CheckSatisfied(result.GetSolution(b.variables()), tolerance)
+               for b in prog.GetAllConstraints()) and np.all(np.isfinite(x))
+
+
+def solve_ik_seeds(arm: ArmPlant, X_WG: RigidTransform, seeds, *,
+                   min_distance: float | None = 0.005, **kwargs) -> IkResult:
+    """`solve_ik` from each seed in turn (the IK is local): the first success, else the last
+    failure. The seeds' order is a preference (the cost pulls a solution towards its seed).
+
+    With `min_distance`, each seed first gets an IK without collision constraints (a few
+    milliseconds, and it fails fast where the pose is out of reach); only its solution, when there
+    is one and it differs from the ones already tried, starts the IK with the minimum-distance
+    constraints. `kwargs` go to `solve_ik`.
+    """
+    if len(seeds) == 0:
+        raise ValueError("solve_ik_seeds needs at least one seed")
+    result = None
+    tried = []
+    for q_seed in seeds:
+        free = solve_ik(arm, X_WG, q_seed=q_seed, min_distance=None, **kwargs)
+        if min_distance is None or not free.success:
+            result = free
+            if free.success:
+                return free
+            continue
+        if any(np.max(np.abs(free.q - q)) < 0.05 for q in tried):  # [rad] the same basin
+            continue
+        tried.append(free.q)
+        result = solve_ik(arm, X_WG, q_seed=q_seed, q_guess=free.q, min_distance=min_distance,
+                          **kwargs)
+        if result.success:
+            return result
+    if tried:
+        result.reason = (f"within reach, but no IK solution keeps {min_distance} m of clearance "
+                         f"(tried from {len(tried)} configuration(s))")
+    else:
+        result.reason = f"out of reach within the joint limits (from {len(seeds)} seeds)"
+    return result

@@ -1,0 +1,260 @@
+"""The grasp planner core: IK for side and top grasps, unreachable objects as results, and a
+pick-and-place trajectory that keeps the velocity limits and its clearance."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pydrake.math import RigidTransform, RotationMatrix
+
+from tg_drake.planning.ik import (CONSTRAINT_TOLERANCE, clearance, make_arm_plant,
+                                  solve_ik_seeds)
+from tg_drake.planning.planner import PlannerConfig, place_pose, plan_pick_and_place
+from tg_drake.planning.trajectory import IIWA_VELOCITY_LIMITS
+from tg_drake.scenario import IIWA_HOME
+from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, PartBox
+
+GRASP_POINT = 0.055  # [m] along +y_G from the WSG body origin (robot_facts.md)
+# The IK tolerances of PlannerConfig: 2 mm per axis (so up to 2·√3 mm), 0.02 rad; plus what the
+# accepted constraint violation (ik.CONSTRAINT_TOLERANCE, 1e-5) allows: 1e-5 m, and, on the
+# orientation constraint's cosine near 0.02 rad, 1e-5 / (2 sin 0.02) ≈ 2.5e-4 rad.
+IK_POSITION_ERROR = 2e-3 * np.sqrt(3) + 1e-5
+IK_ANGLE_ERROR = 0.02 + 3e-4
+
+
+def grasp_pose(p_W_grasp, approach_W, closing_W) -> np.ndarray:
+    """X_WG (4×4) with the grasp point at p_W_grasp, approach +y_G, fingers closing along x_G."""
+    y = np.asarray(approach_W, float) / np.linalg.norm(approach_W)
+    x = np.asarray(closing_W, float) / np.linalg.norm(closing_W)
+    X = np.eye(4)
+    X[:3, :3] = np.column_stack([x, y, np.cross(x, y)])
+    X[:3, 3] = np.asarray(p_W_grasp, float) - GRASP_POINT * y
+    return X
+
+
+def box_object(p_W_center, extents, parts=("bottom", "middle", "top")) -> ObjectDescription:
+    """An upright box on the table, its height split evenly into the given parts (bottom up)."""
+    extents = np.asarray(extents, float)
+    X_WO = np.eye(4)
+    X_WO[:3, 3] = p_W_center
+    boxes = {}
+    for k, name in enumerate(parts):
+        X_WB = X_WO.copy()
+        X_WB[2, 3] += -extents[2] / 2 + extents[2] * (k + 0.5) / len(parts)
+        boxes[name] = PartBox(X_WB, np.array([extents[0], extents[1], extents[2] / len(parts)]) / 2)
+    return ObjectDescription(
+        p_W=np.zeros((0, 3)), n_W=np.zeros((0, 3)), labels=np.zeros(0, int),
+        visible=np.zeros(0, bool), X_WO=X_WO, extents=extents, pose="upright",
+        pose_likelihood={"upright": 1.0}, part_probabilities=dict.fromkeys(parts, 1.0),
+        part_boxes=boxes, pregrasp_X_WG=np.zeros((0, 4, 4)), pregrasp_parts=np.zeros(0, int))
+
+
+def candidates(poses_and_parts, scores=None) -> GraspCandidates:
+    X = np.array([X for X, _ in poses_and_parts])
+    parts = np.array([PART_LABELS.index(p) for _, p in poses_and_parts])
+    scores = np.linspace(0.9, 0.5, len(parts)) if scores is None else np.asarray(scores, float)
+    return GraspCandidates(X_WG=X, parts=parts, p_part=scores, p_local=np.ones(len(parts)),
+                           score=scores)
+
+
+def assert_gripper_at(arm, q, X_WG):
+    arm.plant.SetPositions(arm.plant_context, arm.full_q(q))
+    X = arm.G.CalcPoseInWorld(arm.plant_context)
+    assert np.linalg.norm(X.translation() - X_WG[:3, 3]) <= IK_POSITION_ERROR
+    angle = (X.rotation().inverse() @ RotationMatrix(X_WG[:3, :3])).ToAngleAxis().angle()
+    assert angle <= IK_ANGLE_ERROR
+
+
+def assert_within_joint_limits(arm, q):
+    idx = arm.iiwa_indices
+    assert np.all(q >= arm.plant.GetPositionLowerLimits()[idx] - 1e-9)
+    assert np.all(q <= arm.plant.GetPositionUpperLimits()[idx] + 1e-9)
+
+
+# A 0.07 × 0.07 × 0.20 m box standing at the table centre, 0.75 m in front of the robot, a little
+# to the left.
+BOX = box_object([0.75, 0.1, 0.10], [0.07, 0.07, 0.20])
+SIDE = grasp_pose([0.75, 0.1, 0.15], approach_W=[1, 0, 0], closing_W=[0, 1, 0])
+TOP = grasp_pose([0.75, 0.1, 0.17], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
+
+
+@pytest.fixture(scope="module")
+def arm_with_box():
+    """The arm plant with the box as an obstacle its finger pads may overlap (as when grasping)."""
+    return make_arm_plant(obstacles=[("box", RigidTransform(BOX.X_WO), tuple(BOX.extents))],
+                          finger_contact=["box"])
+
+
+@pytest.mark.parametrize("X_WG", [SIDE, TOP], ids=["side", "top"])
+def test_ik_finds_a_grasp_on_a_box(arm_with_box, X_WG):
+    r = solve_ik_seeds(arm_with_box, RigidTransform(X_WG), [np.array(IIWA_HOME)],
+                       min_distance=0.003)
+    assert r.success, r.reason
+    assert_gripper_at(arm_with_box, r.q, X_WG)
+    assert_within_joint_limits(arm_with_box, r.q)
+    # 3 mm: the IK's minimum-distance bound; the palm and the arm keep clear of the box.
+    assert clearance(arm_with_box, r.q) >= 0.003 - 1e-4
+
+
+def test_pregrasp_into_the_box_is_refused_when_the_box_is_an_obstacle():
+    """A grasp pose whose palm would sit inside the box: the fingers may overlap it, the palm
+    may not."""
+    arm = make_arm_plant(obstacles=[("box", RigidTransform(BOX.X_WO), tuple(BOX.extents))],
+                         finger_contact=["box"])
+    deep = grasp_pose([0.75, 0.1, 0.10], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
+    r = solve_ik_seeds(arm, RigidTransform(deep), [np.array(IIWA_HOME)], min_distance=0.003)
+    assert not r.success
+    assert "clearance" in r.reason
+
+
+def test_velocity_limits_are_the_robot_facts():
+    arm = make_arm_plant()
+    # robot_facts.md, max velocity of joints 1–7 [rad/s].
+    np.testing.assert_array_equal(IIWA_VELOCITY_LIMITS,
+                                  [1.48353, 1.48353, 1.74533, 1.30900, 2.26893, 2.35619, 2.35619])
+    np.testing.assert_allclose(arm.plant.GetVelocityUpperLimits()[arm.iiwa_indices],
+                               IIWA_VELOCITY_LIMITS, rtol=1e-12)
+
+
+def test_object_out_of_reach_is_an_unreachable_result():
+    far = box_object([1.6, 0.0, 0.06], [0.07, 0.07, 0.12])
+    c = candidates([(grasp_pose([1.6, 0, 0.09], [1, 0, 0], [0, 1, 0]), "middle"),
+                    (grasp_pose([1.6, 0, 0.11], [0, 0, -1], [0, 1, 0]), "top"),
+                    (grasp_pose([1.6, 0, 0.11], [0, 0, -1], [1, 0, 0]), "top")])
+    r = plan_pick_and_place(c, target=far, place_xy=(0.7, -0.3))
+    assert r.status == "unreachable"
+    assert r.plan is None
+    assert set(r.unreachable_parts) == {"middle", "top"}
+    assert r.part_reachable == {"middle": False, "top": False}
+    assert np.all(np.isinf(r.costs))
+    assert all("pre-grasp pose unreachable" in reason for reason in r.candidate_reasons)
+    assert "middle" in r.reason and "top" in r.reason
+
+
+def test_max_parts_tries_only_the_leading_part():
+    """The closed loop asks for one part at a time: the leading part's candidates are all
+    unreachable (they approach from under the table), the next part is not examined."""
+    c = candidates([(grasp_pose([0.75, 0.1, 0.03], [0, 0, 1], [0, 1, 0]), "bottom"),
+                    (grasp_pose([0.75, 0.1, 0.03], [0, 0, 1], [1, 0, 0]), "bottom"),
+                    (TOP, "top")])
+    r = plan_pick_and_place(c, target=BOX, place_xy=(0.75, -0.25), max_parts=1)
+    assert r.status == "unreachable"
+    assert r.unreachable_parts == ("bottom",)
+    assert np.all(np.isinf(r.costs[:2])) and np.isnan(r.costs[2])
+    # With the bottom excluded (the logic's collision(bottom) evidence), the top is planned.
+    r = plan_pick_and_place(c, target=BOX, place_xy=(0.75, -0.25), max_parts=1,
+                            exclude_parts=("bottom",))
+    assert r.status == "planned"
+    assert (r.candidate, r.part) == (2, "top")
+
+
+def test_part_wider_than_the_opening_is_infeasible():
+    wide = box_object([0.75, 0.1, 0.06], [0.07, 0.16, 0.12])
+    c = candidates([(grasp_pose([0.75, 0.1, 0.09], [0, 0, -1], [0, 1, 0]), "top")])
+    r = plan_pick_and_place(c, target=wide, place_xy=(0.75, -0.25))
+    assert r.status == "unreachable"
+    assert np.isinf(r.costs[0])
+    assert "across the fingers" in r.candidate_reasons[0]
+
+
+def test_place_pose_keeps_orientation_and_lifts_the_box_off_the_table():
+    X_WO = RigidTransform(RotationMatrix.MakeXRotation(np.pi / 2), [0.7, 0.1, 0.035])
+    X = place_pose(X_WO.GetAsMatrix4(), [0.07, 0.2, 0.07], (0.6, -0.3), release_height=0.01)
+    np.testing.assert_allclose(X[:3, :3], X_WO.rotation().matrix(), atol=1e-15)
+    # Turned about x, the box's 0.2 m side (its y axis) is vertical: its centre goes 0.1 m up,
+    # plus the release height.
+    np.testing.assert_allclose(X[:3, 3], [0.6, -0.3, 0.1 + 0.01], atol=1e-12)
+
+
+# A full plan with a second object next to the target, reused by the trajectory checks.
+OTHER = box_object([0.62, 0.28, 0.08], [0.08, 0.08, 0.16])
+PLACE_XY = (0.7, -0.3)
+
+
+@pytest.fixture(scope="module")
+def planned():
+    c = candidates([(SIDE, "top"), (TOP, "top")])
+    return plan_pick_and_place(c, target=BOX, obstacles=[OTHER], place_xy=PLACE_XY,
+                               q_start=IIWA_HOME)
+
+
+def test_plan_reaches_its_key_poses(planned):
+    r = planned
+    assert r.status == "planned", r.reason
+    plan = r.plan
+    assert plan.candidate == r.candidate == 0 and plan.part == "top"
+    assert np.isfinite(r.costs[0]) and np.isnan(r.costs[1])
+    arm = make_arm_plant()
+    np.testing.assert_allclose(plan.q(0.0), IIWA_HOME, atol=1e-9)
+    assert_gripper_at(arm, plan.q(plan.t_grasp_closed), SIDE)
+    X_lift = SIDE.copy()
+    X_lift[2, 3] += PlannerConfig().lift_height
+    assert_gripper_at(arm, plan.q(plan.t_lift_done), X_lift)
+    # At release the box's frame is at the place target (its grasp offset carried along).
+    X_WG_place = plan.X_WO_place @ np.linalg.inv(BOX.X_WO) @ SIDE
+    assert_gripper_at(arm, plan.q(plan.t_place_done), X_WG_place)
+    np.testing.assert_allclose(plan.X_WO_place[:2, 3], PLACE_XY, atol=1e-12)
+    # The gripper: open on the way in, closed from the grasp to the release, open at the end.
+    c = PlannerConfig()
+    assert plan.width(plan.t_grasp_closed - c.settle_duration - c.close_duration) == c.open_width
+    assert plan.width(plan.t_grasp_closed) == c.closed_width
+    assert plan.width(plan.t_lift_done) == c.closed_width
+    assert plan.width(plan.t_place_done) == c.open_width
+    assert plan.width(plan.duration + 1.0) == c.open_width
+    assert 0 < plan.t_grasp_closed < plan.t_lift_done < plan.t_place_done < plan.duration
+    # At rest at the end, and held there afterwards.
+    np.testing.assert_allclose(plan.v(plan.duration), 0.0, atol=1e-9)
+    np.testing.assert_allclose(plan.q(plan.duration + 5.0), plan.q(plan.duration), atol=0)
+
+
+def test_trajectory_keeps_velocity_and_acceleration_limits(planned):
+    plan = planned.plan
+    t = np.arange(0.0, plan.duration, 0.002)
+    v = np.array([plan.v(ti) for ti in t])
+    # The B-spline's bounds hold on its derivatives' control points, hence everywhere, up to the
+    # constraint violation the planner accepts from the solver (CONSTRAINT_TOLERANCE, 1e-5).
+    assert np.all(np.abs(v) <= IIWA_VELOCITY_LIMITS + CONSTRAINT_TOLERANCE)
+    a = np.array([plan.q_traj.EvalDerivative(ti, 2)[:, 0] for ti in t])
+    assert np.all(np.abs(a) <= PlannerConfig().free_limits.acceleration + CONSTRAINT_TOLERANCE)
+    # The slower straight moves at the object keep their scaled velocity limits.
+    c = PlannerConfig()
+    for name, t0, t1, _ in plan.segments:
+        if name in ("approach", "lift", "descend", "retreat"):
+            inside = (t >= t0) & (t <= t1)
+            assert np.all(np.abs(v[inside]) <= c.contact_limits.velocity_scale
+                          * IIWA_VELOCITY_LIMITS + CONSTRAINT_TOLERANCE), name
+    # The velocity output is the derivative of the position output (central differences over
+    # 1 ms; 1e-3 rad/s covers the O(h²·jerk) error and the segment joints).
+    h = 1e-3
+    inner = t[(t > h) & (t < plan.duration - h)][::10]
+    fd = np.array([(plan.q(ti + h) - plan.q(ti - h)) / (2 * h) for ti in inner])
+    np.testing.assert_allclose(fd, np.array([plan.v(ti) for ti in inner]), atol=1e-3)
+
+
+def test_trajectory_stays_clear_of_collisions(planned):
+    """Each segment, sampled every 5 ms, on a plant built here independently of the planner:
+    the free moves keep the arm, gripper and carried box clear of the table and both boxes; the
+    moves at the object let the finger pads overlap the target's box (they straddle it)."""
+    plan = planned.plan
+    c = PlannerConfig()
+    X_GO = RigidTransform(np.linalg.inv(SIDE) @ BOX.X_WO)
+    other = ("other", RigidTransform(OTHER.X_WO), tuple(OTHER.extents))
+    target = ("target", RigidTransform(BOX.X_WO), tuple(BOX.extents))
+    placed = ("target", RigidTransform(plan.X_WO_place), tuple(BOX.extents))
+    free = make_arm_plant(obstacles=[other, target])
+    at_target = make_arm_plant(obstacles=[other, target], finger_contact=["target"])
+    carrying = make_arm_plant(obstacles=[other], held=(X_GO, tuple(BOX.extents)))
+    at_place = make_arm_plant(obstacles=[other, placed], finger_contact=["target"])
+    plants = {"move": (free, c.min_distance), "approach": (at_target, c.contact_min_distance),
+              "lift": (at_target, c.contact_min_distance),
+              "carry": (carrying, c.min_distance),
+              "descend": (carrying, c.contact_min_distance),
+              "retreat": (at_place, c.contact_min_distance)}
+    assert [s[0] for s in plan.segments] == list(plants)
+    for name, t0, t1, reported in plan.segments:
+        arm, min_distance = plants[name]
+        d = min(clearance(arm, plan.q(t)) for t in np.arange(t0, t1, 0.005))
+        # No penetration anywhere; and at least half the required clearance (the planner's
+        # dense check), less 1 mm for the planner's own sample spacing (0.01 rad of a joint).
+        assert d >= 0.5 * min_distance - 1e-3, (name, d)
+        assert reported >= 0.5 * min_distance

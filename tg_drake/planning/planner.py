@@ -1,0 +1,450 @@
+"""The grasp planner: from ranked grasp candidates to a pick-and-place joint trajectory.
+
+    result = plan_pick_and_place(candidates, target=obj, obstacles=others, place_xy=(0.75, -0.3),
+                                 q_start=q)
+    if result.status == "planned":
+        result.plan.q(t), result.plan.v(t), result.plan.width(t)
+
+Candidates are tried best first (paper section VI: the pre-grasp hypotheses are pruned "by a
+collision checker and the motion trajectory planner"). For a candidate grasp pose X_WG (gripper
+frame G: fingers close along ±x_G, approach along +y_G) the planner needs inverse-kinematics
+solutions, inside the joint limits and clear of collisions, for
+
+    pre-grasp   X_WG moved `pregrasp_distance` back along −y_G     (the target is an obstacle)
+    grasp       X_WG                                                (the target is not)
+    lift        X_WG raised `lift_height`                           (the target is in the hand)
+    pre-place   the place pose raised `lift_height`                 (in the hand)
+    place       X_WG carried with the object to X_WO_place          (in the hand)
+    retreat     the place pose moved `retreat_distance` along −y_G  (the target stands at the place)
+
+where X_WO_place is the object's pose X_WO moved to the place target's xy, its orientation kept,
+and raised so that its box's lowest corner is `release_height` above the table. The IK is local,
+so every pose is tried from several seeds (the start posture, IIWA_HOME and postures turned
+towards the target). The joint trajectories between these configurations come from
+`tg_drake.planning.trajectory.plan_segment` (kinematic trajectory optimisation, collision checked
+densely); approach, lift, descent and retreat are straight-line moves of the gripper.
+
+The first candidate for which everything succeeds is chosen. A failure is a result, not an
+exception: `PlanResult(status="unreachable", unreachable_parts=..., reason=...)`, and every
+candidate found infeasible gets cost inf. The parts for which no candidate gave a plan are what the
+logic receives as `collision(Part)` evidence (`tg_drake.systems.grasp_planner`).
+
+Obstacles are the perceived objects' bounding boxes (`ObjectDescription.X_WO`, `extents`); the
+held object is its bounding box welded to the gripper.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.math import RigidTransform
+from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
+
+from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
+from tg_drake.planning.trajectory import (SegmentConfig, SegmentLimits, StraightLine,
+                                          plan_segment, shifted)
+from tg_drake.scenario import IIWA_HOME, Scenario
+from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, SceneDescription
+
+
+@dataclass
+class PlannerConfig:
+    """Distances, clearances, gripper timing and limits of the pick-and-place plan."""
+
+    pregrasp_distance: float = 0.10  # [m] the pre-grasp stands this far back along −y_G.
+    lift_height: float = 0.15  # [m] lift (and pre-place height above the place pose).
+    retreat_distance: float = 0.10  # [m] after release, back along −y_G.
+    release_height: float = 0.01  # [m] gap under the object's box at the place pose.
+    open_width: float = 0.11  # [m] WSG opening while moving (its full stroke).
+    closed_width: float = 0.0  # [m] commanded to grasp: the driver's force limit stops the
+    # fingers on the object, so the grip force is the WSG driver's `force_limit`.
+    width_margin: float = 0.01  # [m] a part must be this much narrower than the opening.
+    close_duration: float = 0.8  # [s] opening → closed command ramp (scripted.py's timing).
+    settle_duration: float = 0.4  # [s] hold after closing, before lifting.
+    open_duration: float = 0.5  # [s] closed → open at release.
+    min_distance: float = 0.01  # [m] clearance of free and carrying motions.
+    contact_min_distance: float = 0.003  # [m] clearance near the target (approach, grasp,
+    # lift, descent, place, retreat), where the fingers straddle the object.
+    ik_position_tolerance: float = 0.002  # [m] per axis.
+    ik_angle_tolerance: float = 0.02  # [rad]
+    seed_postures: tuple = (
+        IIWA_HOME,
+        (0.0, 0.6, 0.0, -1.3, 0.0, 1.0, 0.0),  # reaching forward and low
+        (0.0, 0.3, 0.0, -1.6, 0.0, -1.0, 0.0),  # wrist flipped
+        (0.0, 0.2, 0.0, -1.0, 0.0, 1.6, 0.0),  # from above
+    )  # [rad] IK seeds; each is also tried with joint 1 turned towards the target.
+    max_candidates_per_part: int = 12  # candidates examined per part before giving up on it.
+    free_limits: SegmentLimits = field(default_factory=SegmentLimits)  # moving to the pre-grasp
+    contact_limits: SegmentLimits = field(default_factory=lambda: SegmentLimits(
+        velocity_scale=0.25, min_duration=1.0))  # straight moves at the object
+    carry_limits: SegmentLimits = field(default_factory=lambda: SegmentLimits(
+        velocity_scale=0.5, min_duration=1.0))  # carrying the object to the pre-place
+    segment: SegmentConfig = field(default_factory=SegmentConfig)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A pick-and-place plan; its time starts at 0 (the system offsets it by the planning time)."""
+
+    q_traj: CompositeTrajectory  # (7,) iiwa joint positions [rad]
+    v_traj: object  # (7,) its time derivative [rad/s]
+    width_traj: PiecewisePolynomial  # (1,) commanded WSG opening [m]
+    t_grasp_closed: float  # [s] the closing command has reached `closed_width` and settled
+    t_lift_done: float  # [s]
+    t_place_done: float  # [s] the object is released at the place pose
+    duration: float  # [s] end of the retreat
+    candidate: int  # index into the GraspCandidates
+    part: str  # its part name
+    X_WG_grasp: np.ndarray  # 4×4 grasp pose
+    X_WO_place: np.ndarray  # 4×4 object pose at release
+    waypoints: dict  # name → (7,) iiwa configuration
+    segments: tuple  # (name, t_start, t_end, min_clearance [m]) per moving segment
+
+    def q(self, t: float) -> np.ndarray:
+        """(7,) joint positions at plan time t (held at the ends outside [0, duration])."""
+        t = min(max(t, 0.0), self.duration)
+        return self.q_traj.value(t)[:, 0]
+
+    def v(self, t: float) -> np.ndarray:
+        """(7,) joint velocities at plan time t (zero outside [0, duration])."""
+        if t < 0.0 or t > self.duration:
+            return np.zeros(7)
+        return self.v_traj.value(t)[:, 0]
+
+    def width(self, t: float) -> float:
+        """Commanded WSG opening [m] at plan time t."""
+        t = min(max(t, 0.0), self.duration)
+        return float(self.width_traj.value(t)[0, 0])
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    status: str  # "planned" or "unreachable"
+    plan: Plan | None
+    costs: np.ndarray  # (M,) per candidate: −log(score) if chosen, inf if infeasible, nan if
+    # not examined (a better candidate was chosen first, or its part was not tried).
+    candidate_reasons: tuple  # (M,) why each infeasible candidate failed ("" otherwise)
+    part_reachable: dict  # examined part name → whether any of its pre-grasps had an IK solution
+    unreachable_parts: tuple  # examined parts none of whose candidates gave a plan
+    reason: str = ""
+    planning_time: float = 0.0  # [s] wall time
+    candidate: int | None = None
+    part: str | None = None
+
+
+def place_pose(X_WO: np.ndarray, extents, place_xy, *, table_z: float = 0.0,
+               release_height: float = 0.01) -> np.ndarray:
+    """X_WO moved to `place_xy` (world) with its orientation kept, its box's lowest corner
+    `release_height` above the table top at `table_z`."""
+    corners = np.array(np.meshgrid(*[(-0.5, 0.5)] * 3)).reshape(3, -1).T * np.asarray(extents)
+    lowest = np.min((X_WO[:3, :3] @ corners.T)[2])  # relative to the origin of O
+    X = X_WO.copy()
+    X[:2, 3] = place_xy
+    X[2, 3] = table_z + release_height - lowest
+    return X
+
+
+def plan_for_scene(scene: SceneDescription, candidates: GraspCandidates, *, place_xy, q_start,
+                   **kwargs) -> PlanResult:
+    """`plan_pick_and_place` with the target `candidates.target` of `scene`, the other objects as
+    obstacles and the table height from the scene's table frame."""
+    target = scene.objects[candidates.target]
+    others = [o for i, o in enumerate(scene.objects) if i != candidates.target]
+    return plan_pick_and_place(candidates, target=target, obstacles=others, place_xy=place_xy,
+                               q_start=q_start, table_z=float(scene.X_WT[2, 3]), **kwargs)
+
+
+def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescription,
+                        obstacles=(), place_xy, q_start=IIWA_HOME, table_z: float = 0.0,
+                        config: PlannerConfig | None = None, scenario: Scenario | None = None,
+                        exclude_parts=(), max_parts: int | None = None) -> PlanResult:
+    """The first candidate (by score) with a full collision-free pick-and-place plan.
+
+    Args:
+        candidates: grasp poses X_WG with part labels and scores.
+        target: the object to pick; obstacles: the other objects (their boxes are obstacles).
+        place_xy: (2,) world xy where the object's frame origin goes.
+        q_start: (7,) iiwa configuration the plan starts from.
+        table_z: world height of the table top.
+        scenario: its directives give the robot and table models (default: the station's).
+        exclude_parts: part names not to try (already found unreachable).
+        max_parts: try only the candidates of the first this many parts (in order of their best
+            candidate); None tries all.
+    """
+    config = config or PlannerConfig()
+    t_start = time.perf_counter()
+    q_start = np.asarray(q_start, float)
+    m = len(candidates.score)
+    costs = np.full(m, np.nan)
+    reasons = [""] * m
+    part_reachable: dict[str, bool] = {}
+    part_planned: dict[str, bool] = {}
+
+    # Candidates in order of score, grouped into the parts to try.
+    order = np.argsort(-np.asarray(candidates.score, float), kind="stable")
+    parts_order = []
+    for i in order:
+        name = PART_LABELS[int(candidates.parts[i])]
+        if name not in exclude_parts and name not in parts_order:
+            parts_order.append(name)
+    if max_parts is not None:
+        parts_order = parts_order[:max_parts]
+    if not parts_order:
+        return PlanResult("unreachable", None, costs, tuple(reasons), {}, (),
+                          "no candidate grasps left to try", time.perf_counter() - t_start)
+
+    X_WO = np.asarray(target.X_WO, float)
+    X_WO_place = place_pose(X_WO, target.extents, place_xy, table_z=table_z,
+                            release_height=config.release_height)
+    boxes = [(f"object{i}", RigidTransform(o.X_WO), tuple(o.extents))
+             for i, o in enumerate(obstacles)]
+    target_box = ("target", RigidTransform(X_WO), tuple(target.extents))
+    placed_box = ("target_placed", RigidTransform(X_WO_place), tuple(target.extents))
+    arms = _Arms(scenario, config.open_width, boxes, target_box, placed_box)
+    bearing = float(np.arctan2(X_WO[1, 3], X_WO[0, 3]))
+    seeds = _seeds(q_start, config.seed_postures, bearing)
+
+    tried = {name: 0 for name in parts_order}
+    plan = None
+    for i in order:
+        part = PART_LABELS[int(candidates.parts[i])]
+        if part not in tried or tried[part] >= config.max_candidates_per_part:
+            continue
+        tried[part] += 1
+        part_reachable.setdefault(part, False)
+        part_planned.setdefault(part, False)
+        score = float(candidates.score[i])
+        if not np.isfinite(score) or score <= 0.0:
+            costs[i], reasons[i] = np.inf, "score 0: ruled out"
+            continue
+        X_WG = np.asarray(candidates.X_WG[i], float)
+        width = _part_width(target, part, X_WG)
+        if width > config.open_width - config.width_margin:
+            costs[i], reasons[i] = np.inf, (f"{part} is {width:.3f} m across the fingers; the "
+                                            f"WSG opens {config.open_width} m")
+            continue
+        key = _key_poses(arms, X_WG, X_WO, X_WO_place, config)
+        below = [n for n in ("pre-grasp", "grasp") if key.X[n].translation()[2] < table_z]
+        if below:  # the WSG body's origin under the table top: no need to ask the IK
+            costs[i], reasons[i] = np.inf, f"{below[0]} pose puts the gripper under the table"
+            continue
+        poses, failure = _waypoint_configurations(arms, key, seeds, config)
+        if "pre-grasp" in poses:
+            part_reachable[part] = True
+        if failure:
+            costs[i], reasons[i] = np.inf, failure
+            continue
+        plan, failure = _trajectories(arms, q_start, poses, key, config, seeds,
+                                      candidate=int(i), part=part)
+        if plan is None:
+            costs[i], reasons[i] = np.inf, failure
+            continue
+        costs[i] = -np.log(score)
+        part_planned[part] = True
+        break
+
+    elapsed = time.perf_counter() - t_start
+    unreachable = tuple(p for p in parts_order if p in part_planned and not part_planned[p])
+    if plan is None:
+        examined = [r for r in reasons if r]
+        reason = ("no candidate of " + ", ".join(unreachable) + " can be executed; first "
+                  "failure: " + (examined[0] if examined else "none examined"))
+        return PlanResult("unreachable", None, costs, tuple(reasons), part_reachable,
+                          unreachable, reason, elapsed)
+    return PlanResult("planned", plan, costs, tuple(reasons), part_reachable, unreachable, "",
+                      elapsed, plan.candidate, plan.part)
+
+
+class _Arms:
+    """The arm plants of one planning call, each built when first needed.
+
+    free: the other objects and the target are obstacles (moving to the pre-grasp);
+    grasp: the same, but the finger pads may overlap the target's box (approach, grasp, lift);
+    carry(X_GO): the other objects, and the target's box in the hand (lift to place);
+    placed: the other objects and the target at its place pose, which the finger pads may overlap
+    (release, retreat)."""
+
+    def __init__(self, scenario, opening, boxes, target_box, placed_box):
+        self._scenario, self._opening = scenario, opening
+        self._boxes, self._target, self._placed = list(boxes), target_box, placed_box
+        self._cache: dict = {}
+
+    def _make(self, key, extra=(), held=None, finger_contact=()) -> ArmPlant:
+        if key not in self._cache:
+            self._cache[key] = make_arm_plant(
+                self._scenario, obstacles=self._boxes + list(extra),
+                finger_opening=self._opening, held=held, finger_contact=finger_contact)
+        return self._cache[key]
+
+    @property
+    def free(self) -> ArmPlant:
+        return self._make("free", [self._target])
+
+    @property
+    def grasp(self) -> ArmPlant:
+        return self._make("grasp", [self._target], finger_contact=[self._target[0]])
+
+    @property
+    def placed(self) -> ArmPlant:
+        return self._make("placed", [self._placed], finger_contact=[self._placed[0]])
+
+    def carry(self, X_GO: RigidTransform) -> ArmPlant:
+        key = ("carry", tuple(np.round(X_GO.GetAsMatrix4().ravel(), 9)))
+        return self._make(key, held=(X_GO, self._target[2]))
+
+
+def _seeds(q_start, postures, bearing) -> list[np.ndarray]:
+    seeds = [np.asarray(q_start, float)]
+    for posture in postures:
+        q = np.asarray(posture, float)
+        turned = q.copy()
+        turned[0] = bearing
+        seeds += [turned, q]
+    unique = []
+    for q in seeds:
+        if not any(np.allclose(q, u) for u in unique):
+            unique.append(q)
+    return unique
+
+
+def _part_width(target: ObjectDescription, part: str, X_WG: np.ndarray) -> float:
+    """Width [m] of the part's box along the closing direction x_G (0 when no box is known)."""
+    box = target.part_boxes.get(part)
+    if box is None:
+        return 0.0
+    x_B = np.asarray(box.X_WB)[:3, :3].T @ X_WG[:3, 0]
+    return float(2.0 * np.abs(x_B) @ np.asarray(box.half_extents))
+
+
+@dataclass
+class _KeyPoses:
+    """The gripper poses of one candidate and the plant that carries its object."""
+
+    X: dict  # name → RigidTransform X_WG, in execution order
+    X_GO: RigidTransform  # the target in the hand
+    X_WO_place: np.ndarray  # 4×4 object pose at the place pose
+
+
+def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config) -> _KeyPoses:
+    X_WG = RigidTransform(X_WG)
+    y_G = X_WG.rotation().col(1)
+    up = np.array([0.0, 0.0, config.lift_height])
+    X_OG = RigidTransform(X_WO).inverse() @ X_WG
+    X_WG_place = RigidTransform(X_WO_place) @ X_OG
+
+    def moved(X, p_W):
+        return RigidTransform(X.rotation(), X.translation() + p_W)
+
+    X = {"pre-grasp": moved(X_WG, -config.pregrasp_distance * y_G),
+         "grasp": X_WG,
+         "lift": moved(X_WG, up),
+         "pre-place": moved(X_WG_place, up),
+         "place": X_WG_place,
+         "retreat": moved(X_WG_place, -config.retreat_distance * y_G)}
+    return _KeyPoses(X, X_OG.inverse(), np.asarray(X_WO_place, float))
+
+
+def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
+    """IK for the six key poses of one candidate: ({name: q}, failure reason or "").
+
+    Each pose is checked on the plant that matches what the hand holds there, with the clearance
+    of the motion around it; after the pre-grasp, the previous configuration is the first seed
+    (the straight moves between them need nearby configurations)."""
+    steps = {  # the plants are built only when a candidate gets that far
+        "pre-grasp": (lambda: arms.free, config.min_distance),
+        "grasp": (lambda: arms.grasp, config.contact_min_distance),
+        "lift": (lambda: arms.carry(key.X_GO), config.min_distance),
+        "pre-place": (lambda: arms.carry(key.X_GO), config.min_distance),
+        "place": (lambda: arms.carry(key.X_GO), config.contact_min_distance),
+        "retreat": (lambda: arms.placed, config.contact_min_distance),
+    }
+    poses: dict[str, np.ndarray] = {}
+    previous = None
+    for name, (make_arm, min_distance) in steps.items():
+        arm = make_arm()
+        step_seeds = seeds if previous is None else [previous] + seeds
+        r = solve_ik_seeds(arm, key.X[name], step_seeds,
+                           position_tolerance=config.ik_position_tolerance,
+                           angle_tolerance=config.ik_angle_tolerance, min_distance=min_distance)
+        if not r.success:
+            return poses, f"{name} pose unreachable ({r.reason})"
+        poses[name] = r.q
+        previous = r.q
+    return poses, ""
+
+
+def _line(key: _KeyPoses, a: str, b: str) -> StraightLine:
+    return StraightLine(key.X[a].translation(), key.X[b].translation(), key.X[a].rotation())
+
+
+def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *, candidate,
+                  part):
+    """The segments between the key configurations, assembled into a Plan: (Plan, "") or
+    (None, reason)."""
+    c = config
+    carry = arms.carry(key.X_GO)
+    # name, from, to, plant, clearance, limits, straight line or None (free: via-point guesses)
+    moves = [
+        ("move", "start", "pre-grasp", arms.free, c.min_distance, c.free_limits, None),
+        ("approach", "pre-grasp", "grasp", arms.grasp, c.contact_min_distance, c.contact_limits,
+         _line(key, "pre-grasp", "grasp")),
+        ("lift", "grasp", "lift", arms.grasp, c.contact_min_distance, c.contact_limits,
+         _line(key, "grasp", "lift")),
+        ("carry", "lift", "pre-place", carry, c.min_distance, c.carry_limits, None),
+        ("descend", "pre-place", "place", carry, c.contact_min_distance, c.contact_limits,
+         _line(key, "pre-place", "place")),
+        ("retreat", "place", "retreat", arms.placed, c.contact_min_distance, c.contact_limits,
+         _line(key, "place", "retreat")),
+    ]
+    q = dict(poses, start=np.asarray(q_start, float))
+    solved = {}
+    for name, a, b, arm, min_distance, limits, line in moves:
+        segment = plan_segment(arm, q[a], q[b], min_distance=min_distance, limits=limits,
+                               config=c.segment, line=line, via=seeds if line is None else ())
+        if not segment.success:
+            return None, f"{name} trajectory: {segment.reason}"
+        solved[name] = segment
+
+    # The timeline: move, approach, close, lift, carry, descend, open, retreat.
+    pieces, rows = [], []
+    t = 0.0
+
+    def add_motion(name):
+        nonlocal t
+        s = solved[name]
+        pieces.append(shifted(s.trajectory, t))
+        rows.append((name, t, t + s.duration, s.min_clearance))
+        t += s.duration
+
+    def add_hold(q_hold, duration):
+        nonlocal t
+        pieces.append(PiecewisePolynomial.ZeroOrderHold(
+            [t, t + duration], np.column_stack([q_hold, q_hold])))
+        t += duration
+
+    add_motion("move")
+    add_motion("approach")
+    t_close = t
+    add_hold(q["grasp"], c.close_duration + c.settle_duration)
+    t_grasp_closed = t
+    add_motion("lift")
+    t_lift_done = t
+    add_motion("carry")
+    add_motion("descend")
+    t_open = t
+    add_hold(q["place"], c.open_duration)
+    t_place_done = t
+    add_motion("retreat")
+    q_traj = CompositeTrajectory(pieces)
+    width_traj = PiecewisePolynomial.FirstOrderHold(
+        [0.0, t_close, t_close + c.close_duration, t_open, t_open + c.open_duration, t],
+        np.array([[c.open_width, c.open_width, c.closed_width, c.closed_width, c.open_width,
+                   c.open_width]]))
+    plan = Plan(q_traj=q_traj, v_traj=q_traj.MakeDerivative(), width_traj=width_traj,
+                t_grasp_closed=t_grasp_closed, t_lift_done=t_lift_done,
+                t_place_done=t_place_done, duration=t, candidate=candidate, part=part,
+                X_WG_grasp=key.X["grasp"].GetAsMatrix4(),
+                X_WO_place=key.X_WO_place, waypoints=q, segments=tuple(rows))
+    return plan, ""
