@@ -21,6 +21,7 @@ FIGURES: dict[str, str] = {
     "sim_rtf": "tg_drake.scripted:bench_sim_rtf",
     "kernel_query_ms": "tg_drake.kernels.bench:kernel_query_ms",
     "kernel_loo_s": "tg_drake.kernels.bench:kernel_loo_s",
+    "logic_scene_ms": "tg_drake.logic.bench:logic_scene_ms",
 }
 
 

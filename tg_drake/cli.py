@@ -16,6 +16,7 @@ from tg_drake.errors import TgDrakeError
 
 # command name → module implementing it.
 COMMANDS: dict[str, str] = {
+    "query": "tg_drake.logic.cli",
     "bench": "tg_drake.bench",
     "objects": "tg_drake.objects",
     "render": "tg_drake.render",
