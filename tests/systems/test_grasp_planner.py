@@ -1,0 +1,218 @@
+"""GraspPlanner alone (fixed inputs) and in a small loop with a stand-in for the logic."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pydrake.common.value import AbstractValue
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource
+
+from tg_drake.systems.grasp_planner import GraspPlanner, PlanStatus
+from tg_drake.types import (PART_LABELS, GraspCandidates, ObjectDescription, PartBox,
+                            SceneDescription)
+
+GRASP_POINT = 0.055  # [m] along +y_G from the WSG body origin (robot_facts.md)
+START = 0.5  # [s] the planner's first event
+Q_MEASURED = np.array([0.1, -0.5, 0.05, -1.8, 0.0, 1.1, 0.2])  # a posture near IIWA_HOME
+
+
+def grasp_pose(p_W_grasp, approach_W, closing_W) -> np.ndarray:
+    y = np.asarray(approach_W, float)
+    x = np.asarray(closing_W, float)
+    X = np.eye(4)
+    X[:3, :3] = np.column_stack([x, y, np.cross(x, y)])
+    X[:3, 3] = np.asarray(p_W_grasp, float) - GRASP_POINT * y
+    return X
+
+
+def scene_with_box(p_W_center, extents=(0.07, 0.07, 0.20)) -> SceneDescription:
+    """One upright box on the table, bottom / middle / top thirds as its parts."""
+    extents = np.asarray(extents, float)
+    X_WO = np.eye(4)
+    X_WO[:3, 3] = p_W_center
+    boxes = {}
+    for k, name in enumerate(("bottom", "middle", "top")):
+        X_WB = X_WO.copy()
+        X_WB[2, 3] += -extents[2] / 2 + extents[2] * (k + 0.5) / 3
+        boxes[name] = PartBox(X_WB, np.array([extents[0], extents[1], extents[2] / 3]) / 2)
+    box = ObjectDescription(
+        p_W=np.zeros((0, 3)), n_W=np.zeros((0, 3)), labels=np.zeros(0, int),
+        visible=np.zeros(0, bool), X_WO=X_WO, extents=extents, pose="upright",
+        pose_likelihood={"upright": 1.0}, part_probabilities=dict.fromkeys(boxes, 1.0),
+        part_boxes=boxes, pregrasp_X_WG=np.zeros((0, 4, 4)), pregrasp_parts=np.zeros(0, int))
+    return SceneDescription(objects=[box], X_WT=np.eye(4), target=0)
+
+
+def ranked(poses_and_parts) -> GraspCandidates:
+    X = np.array([X for X, _ in poses_and_parts])
+    parts = np.array([PART_LABELS.index(p) for _, p in poses_and_parts])
+    score = np.linspace(0.9, 0.5, len(parts))
+    return GraspCandidates(X_WG=X, parts=parts, p_part=score, p_local=np.ones(len(parts)),
+                           score=score)
+
+
+SCENE = scene_with_box([0.75, 0.1, 0.10])
+TOP = grasp_pose([0.75, 0.1, 0.17], [0, 0, -1], [0, 1, 0])
+SIDE = grasp_pose([0.75, 0.1, 0.15], [1, 0, 0], [0, 1, 0])
+# Grasps of the bottom from under the table: never reachable.
+FROM_BELOW = [grasp_pose([0.75, 0.1, 0.03], [0, 0, 1], [0, 1, 0]),
+              grasp_pose([0.75, 0.1, 0.03], [0, 0, 1], [1, 0, 0])]
+
+
+def fixed_inputs(planner, scene, grasps):
+    context = planner.CreateDefaultContext()
+    planner.get_scene_description_input_port().FixValue(context, scene)
+    planner.get_ranked_grasps_input_port().FixValue(context, grasps)
+    planner.get_iiwa_state_input_port().FixValue(context, np.concatenate([Q_MEASURED,
+                                                                          np.zeros(7)]))
+    return context
+
+
+def desired(planner, context):
+    return planner.get_iiwa_desired_state_output_port().Eval(context)
+
+
+def status(planner, context) -> PlanStatus:
+    return planner.get_plan_status_output_port().Eval(context)
+
+
+@pytest.fixture(scope="module")
+def reachable_run():
+    """The planner with a reachable top grasp, run to just after its first event."""
+    planner = GraspPlanner(place_xy=(0.75, -0.25), start_time=START)
+    context = fixed_inputs(planner, SCENE, ranked([(TOP, "top"), (SIDE, "middle")]))
+    simulator = Simulator(planner, context)
+    simulator.Initialize()
+    before = {"t": 0.3}
+    simulator.AdvanceTo(before["t"])
+    before.update(q=desired(planner, context).copy(),
+                  wsg=planner.get_wsg_position_output_port().Eval(context)[0],
+                  status=status(planner, context))
+    simulator.AdvanceTo(START + 0.01)
+    return planner, simulator, context, before
+
+
+def test_holds_the_measured_posture_before_planning(reachable_run):
+    _, _, _, before = reachable_run
+    np.testing.assert_array_equal(before["q"], np.concatenate([Q_MEASURED, np.zeros(7)]))
+    assert before["wsg"] == 0.11  # open
+    assert before["status"].status == "planning"
+    assert before["status"].plan is None
+
+
+def test_follows_the_plan_after_the_planning_event(reachable_run):
+    planner, simulator, context, _ = reachable_run
+    s = status(planner, context)
+    assert s.status == "executing"
+    assert (s.part, s.candidate) == ("top", 0)
+    assert s.t_plan == pytest.approx(START, abs=1e-12)
+    np.testing.assert_array_equal(s.X_WG, TOP)
+    plan = s.plan
+    # The plan starts at the held posture, so the command is continuous at the event.
+    np.testing.assert_allclose(plan.q(0.0), Q_MEASURED, atol=1e-9)
+    for t in (START + 0.01, START + plan.t_grasp_closed, START + plan.t_lift_done):
+        simulator.AdvanceTo(t)
+        x = desired(planner, context)
+        np.testing.assert_allclose(x[:7], plan.q(t - START), atol=1e-12)
+        np.testing.assert_allclose(x[7:], plan.v(t - START), atol=1e-12)
+        assert planner.get_wsg_position_output_port().Eval(context)[0] == pytest.approx(
+            plan.width(t - START), abs=1e-12)
+    assert planner.get_wsg_position_output_port().Eval(context)[0] == 0.0  # closed, lifting
+    simulator.AdvanceTo(START + plan.duration + 0.1)
+    assert status(planner, context).status == "done"
+    np.testing.assert_allclose(desired(planner, context)[7:], 0.0, atol=1e-12)
+    assert planner.get_collisions_output_port().Eval(context) == ()
+
+
+def test_unreachable_leading_part_becomes_a_collision():
+    """The bottom leads the ranking but can only be grasped from under the table: after the
+    first event `collisions` lists it (still planning); the next event plans the top."""
+    planner = GraspPlanner(place_xy=(0.75, -0.25), start_time=START)
+    grasps = ranked([(FROM_BELOW[0], "bottom"), (FROM_BELOW[1], "bottom"), (TOP, "top")])
+    context = fixed_inputs(planner, SCENE, grasps)
+    simulator = Simulator(planner, context)
+    simulator.Initialize()
+    simulator.AdvanceTo(START + 0.01)
+    assert planner.get_collisions_output_port().Eval(context) == ("bottom",)
+    s = status(planner, context)
+    assert (s.status, s.requeries, s.unreachable_parts) == ("planning", 1, ("bottom",))
+    np.testing.assert_array_equal(desired(planner, context)[:7], Q_MEASURED)  # still holding
+    simulator.AdvanceTo(START + 0.06)  # the next event, 0.05 s later
+    s = status(planner, context)
+    assert (s.status, s.part, s.candidate) == ("executing", "top", 2)
+    assert s.t_plan == pytest.approx(START + 0.05, abs=1e-9)
+
+
+def test_gives_up_when_no_part_is_left():
+    planner = GraspPlanner(place_xy=(0.75, -0.25), start_time=0.0)
+    far = scene_with_box([1.6, 0.0, 0.10])
+    grasps = ranked([(grasp_pose([1.6, 0.0, 0.15], [1, 0, 0], [0, 1, 0]), "middle"),
+                     (grasp_pose([1.6, 0.0, 0.17], [0, 0, -1], [0, 1, 0]), "top")])
+    context = fixed_inputs(planner, far, grasps)
+    simulator = Simulator(planner, context)
+    simulator.Initialize()
+    simulator.AdvanceTo(0.16)  # events at 0, 0.05, 0.10, 0.15
+    s = status(planner, context)
+    assert s.status == "unreachable"
+    assert s.unreachable_parts == ("middle", "top")
+    assert s.requeries == 2
+    assert "no candidate grasps left" in s.reason
+    np.testing.assert_array_equal(desired(planner, context)[:7], Q_MEASURED)  # holds on
+
+
+def test_gives_up_after_max_requeries():
+    planner = GraspPlanner(place_xy=(0.75, -0.25), start_time=0.0, max_requeries=0)
+    grasps = ranked([(FROM_BELOW[0], "bottom"), (TOP, "top")])
+    context = fixed_inputs(planner, SCENE, grasps)
+    simulator = Simulator(planner, context)
+    simulator.Initialize()
+    simulator.AdvanceTo(0.06)
+    s = status(planner, context)
+    assert (s.status, s.requeries, s.unreachable_parts) == ("unreachable", 0, ("bottom",))
+    assert s.reason.startswith("gave up after 0 re-queries")
+
+
+class _RankerWithoutCollisions(LeafSystem):
+    """A stand-in for the logic + DGI: the given candidates without those of parts in
+    `collisions` (as collision(Part) evidence sets their probability to 0); counts its calls."""
+
+    def __init__(self, grasps: GraspCandidates):
+        super().__init__()
+        self.grasps = grasps
+        self.seen = []
+        self._collisions = self.DeclareAbstractInputPort("collisions", AbstractValue.Make(()))
+        self.DeclareAbstractOutputPort("ranked_grasps", lambda: AbstractValue.Make(grasps),
+                                       self._calc)
+
+    def _calc(self, context, output):
+        collisions = self._collisions.Eval(context)
+        self.seen.append(collisions)
+        keep = np.array([PART_LABELS[p] not in collisions for p in self.grasps.parts], bool)
+        g = self.grasps
+        output.set_value(GraspCandidates(g.X_WG[keep], g.parts[keep], g.p_part[keep],
+                                         g.p_local[keep], g.score[keep]))
+
+
+def test_collisions_feed_back_without_an_algebraic_loop():
+    builder = DiagramBuilder()
+    planner = builder.AddSystem(GraspPlanner(place_xy=(0.75, -0.25), start_time=0.0))
+    ranker = builder.AddSystem(_RankerWithoutCollisions(
+        ranked([(FROM_BELOW[0], "bottom"), (FROM_BELOW[1], "bottom"), (TOP, "top")])))
+    scene = builder.AddSystem(ConstantValueSource(AbstractValue.Make(SCENE)))
+    arm = builder.AddSystem(ConstantVectorSource(np.concatenate([Q_MEASURED, np.zeros(7)])))
+    builder.Connect(planner.get_collisions_output_port(), ranker.get_input_port())
+    builder.Connect(ranker.get_output_port(), planner.get_ranked_grasps_input_port())
+    builder.Connect(scene.get_output_port(), planner.get_scene_description_input_port())
+    builder.Connect(arm.get_output_port(), planner.get_iiwa_state_input_port())
+    diagram = builder.Build()  # raises on an algebraic loop
+    simulator = Simulator(diagram)
+    simulator.Initialize()
+    simulator.AdvanceTo(0.06)
+    context = planner.GetMyContextFromRoot(simulator.get_context())
+    s = status(planner, context)
+    assert (s.status, s.part, s.requeries) == ("executing", "top", 1)
+    # The second event saw the re-ranked grasps: the top candidate is index 0 of those.
+    assert s.candidate == 0
+    assert ("bottom",) in ranker.seen

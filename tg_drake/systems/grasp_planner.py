@@ -1,0 +1,252 @@
+"""The grasp planner as a Drake system, closing the loop with the logic (paper sections IV-D and VI).
+
+The paper's constraint `false :- grasp(X, T, R), part(R, X), collision(R).` connects the reasoning
+module to the execution planner: a part the gripper cannot reach becomes `collision(Part)`
+evidence. `GraspPlanner` keeps the parts it found unreachable in its state and publishes them on
+its ``collisions`` output, which the diagram feeds back to `LogicQuerySystem`; the logic asks again
+and the next ``ranked_grasps`` ranks the remaining parts.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
+
+from tg_drake.planning.planner import Plan, PlannerConfig, PlanResult, plan_for_scene
+from tg_drake.scenario import IIWA_HOME, Scenario
+from tg_drake.types import GraspCandidates, SceneDescription
+
+
+@dataclass(frozen=True)
+class PlanStatus:
+    """Value of the ``plan_status`` output."""
+
+    status: str  # "planning", "executing", "done" or "unreachable"
+    part: str | None = None  # the chosen part
+    candidate: int | None = None  # index of the chosen candidate in the ranked_grasps it came from
+    X_WG: np.ndarray | None = None  # 4×4 chosen grasp pose
+    unreachable_parts: tuple = ()  # parts found unreachable (the collision(Part) evidence)
+    requeries: int = 0  # how often the logic was asked again with new collision evidence
+    reason: str = ""  # why planning failed (status "unreachable"), else ""
+    planning_time: float = 0.0  # [s] wall time spent in the planner so far
+    t_plan: float | None = None  # [s] simulated time at which the plan starts
+    plan: Plan | None = None  # the plan itself (key times in plan time: add t_plan)
+
+    def __deepcopy__(self, memo):
+        return self  # immutable: Drake's copies of abstract values may share it
+
+
+@dataclass(frozen=True)
+class _Memory:
+    """The planner's abstract state. Immutable: updates replace it."""
+
+    q_hold: np.ndarray  # (7,) posture held before a plan exists (measured at initialisation)
+    collisions: tuple = ()  # parts found unreachable so far
+    requeries: int = 0
+    result: PlanResult | None = None  # the successful planning result
+    t_plan: float | None = None  # [s] simulated time the plan starts
+    failure: str = ""  # non-empty: planning gave up, and why
+    planning_time: float = 0.0  # [s] wall time
+
+    def __deepcopy__(self, memo):
+        return self  # immutable: the simulator's state copies may share it
+
+
+class GraspPlanner(LeafSystem):
+    """Plans a pick-and-place for the best reachable grasp and commands the arm and the gripper.
+
+    .. pydrake_system::
+
+        name: GraspPlanner
+        input_ports:
+        - scene_description
+        - ranked_grasps
+        - iiwa.state
+        output_ports:
+        - iiwa.desired_state
+        - wsg.position
+        - collisions
+        - plan_status
+
+    ``scene_description`` (`SceneDescription`) gives the target (``ranked_grasps.target``) and the
+    other objects, whose boxes are obstacles; ``ranked_grasps`` (`GraspCandidates`) are the grasp
+    poses, best first; ``iiwa.state`` (14: q, v) is the measured arm state.
+
+    At initialisation the measured posture is stored; until a plan exists ``iiwa.desired_state``
+    holds it (zero velocity) and ``wsg.position`` holds the gripper open. From `start_time` on, a
+    periodic unrestricted update (every `period` seconds, until planning succeeds or gives up)
+    plans for the leading part of ``ranked_grasps`` (its candidates best first, parts already
+    found unreachable skipped; `tg_drake.planning.planner.plan_pick_and_place`). If every
+    candidate of that part fails, the part joins the state's collisions, published on
+    ``collisions`` (a tuple of part names, from state only: feeding it back to the logic makes no
+    algebraic loop); the next event sees the re-ranked grasps. Planning gives up (status
+    "unreachable") when no part is left or after `max_requeries` re-queries. Once a plan exists,
+    ``iiwa.desired_state`` (q, v) and ``wsg.position`` (opening width [m]; closing is commanded
+    as width `PlannerConfig.closed_width`, the WSG driver's force limit sets the grip) follow it
+    in time from the event at which it was made.
+
+    ``plan_status`` is a `PlanStatus`: "planning", "executing", "done" or "unreachable", with the
+    chosen part and candidate, the unreachable parts, the re-query count and the reason.
+    """
+
+    def __init__(self, *, place_xy, start_time: float = 0.0, period: float = 0.05,
+                 max_requeries: int = 3, config: PlannerConfig | None = None,
+                 scenario: Scenario | None = None):
+        """
+        Args:
+            place_xy: (2,) world xy where the target object's frame origin is placed [m].
+            start_time: simulated time of the first planning event [s] (e.g. after perception
+                has seen the scene).
+            period: spacing of the planning events until a plan exists [s].
+            max_requeries: how many times the logic may be asked again with new collision
+                evidence before the planner gives up.
+            config: the planner's distances, clearances, timing and limits.
+            scenario: whose robot and table models the planner's arm plant uses (default: the
+                station's).
+        """
+        super().__init__()
+        if len(place_xy) != 2:
+            raise ValueError(f"place_xy must be a world (x, y), got {place_xy}")
+        if period <= 0 or start_time < 0:
+            raise ValueError(f"need period > 0 and start_time >= 0, got {period}, {start_time}")
+        self._place_xy = np.asarray(place_xy, float)
+        self._max_requeries = int(max_requeries)
+        self._config = config or PlannerConfig()
+        self._scenario = scenario
+
+        self._scene_port = self.DeclareAbstractInputPort(
+            "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
+        self._grasps_port = self.DeclareAbstractInputPort(
+            "ranked_grasps", AbstractValue.Make(_no_candidates()))
+        self._state_port = self.DeclareVectorInputPort("iiwa.state", 14)
+
+        self._memory = self.DeclareAbstractState(
+            AbstractValue.Make(_Memory(q_hold=np.asarray(IIWA_HOME, float))))
+        self.DeclareInitializationUnrestrictedUpdateEvent(self._initialize)
+        self.DeclarePeriodicUnrestrictedUpdateEvent(period, start_time, self._plan)
+
+        # Outputs depend on the state and the time only (never on an input).
+        on_state = {self.abstract_state_ticket(self._memory)}
+        on_state_and_time = on_state | {self.time_ticket()}
+        self._desired_state_port = self.DeclareVectorOutputPort(
+            "iiwa.desired_state", 14, self._calc_desired_state,
+            prerequisites_of_calc=on_state_and_time)
+        self._wsg_port = self.DeclareVectorOutputPort(
+            "wsg.position", 1, self._calc_wsg_position, prerequisites_of_calc=on_state_and_time)
+        self._collisions_port = self.DeclareAbstractOutputPort(
+            "collisions", lambda: AbstractValue.Make(()), self._calc_collisions,
+            prerequisites_of_calc=on_state)
+        self._status_port = self.DeclareAbstractOutputPort(
+            "plan_status", lambda: AbstractValue.Make(PlanStatus("planning")),
+            self._calc_status, prerequisites_of_calc=on_state_and_time)
+
+    # Port accessors.
+    def get_scene_description_input_port(self):
+        return self._scene_port
+
+    def get_ranked_grasps_input_port(self):
+        return self._grasps_port
+
+    def get_iiwa_state_input_port(self):
+        return self._state_port
+
+    def get_iiwa_desired_state_output_port(self):
+        return self._desired_state_port
+
+    def get_wsg_position_output_port(self):
+        return self._wsg_port
+
+    def get_collisions_output_port(self):
+        return self._collisions_port
+
+    def get_plan_status_output_port(self):
+        return self._status_port
+
+    # Events.
+    def _initialize(self, context, state):
+        q = np.asarray(self._state_port.Eval(context), float)[:7]
+        state.get_mutable_abstract_state(self._memory).set_value(_Memory(q_hold=q.copy()))
+
+    def _plan(self, context, state):
+        memory: _Memory = context.get_abstract_state(self._memory).get_value()
+        if memory.result is not None or memory.failure:
+            return EventStatus.DidNothing()
+        scene: SceneDescription = self._scene_port.Eval(context)
+        grasps: GraspCandidates = self._grasps_port.Eval(context)
+        t0 = time.perf_counter()
+        if len(grasps.score) == 0 or not scene.objects:
+            memory = dataclasses.replace(
+                memory, failure="no grasp candidates" if scene.objects else "no objects seen")
+        else:
+            result = plan_for_scene(scene, grasps, place_xy=self._place_xy,
+                                    q_start=memory.q_hold, config=self._config,
+                                    scenario=self._scenario, exclude_parts=memory.collisions,
+                                    max_parts=1)
+            memory = self._after(memory, result, context.get_time())
+        memory = dataclasses.replace(
+            memory, planning_time=memory.planning_time + time.perf_counter() - t0)
+        state.get_mutable_abstract_state(self._memory).set_value(memory)
+        return EventStatus.Succeeded()
+
+    def _after(self, memory: _Memory, result: PlanResult, t: float) -> _Memory:
+        if result.status == "planned":
+            return dataclasses.replace(memory, result=result, t_plan=t)
+        new = tuple(p for p in result.unreachable_parts if p not in memory.collisions)
+        if not new:  # nothing new to tell the logic: no part left to try
+            return dataclasses.replace(memory, failure=result.reason)
+        collisions = memory.collisions + new
+        if memory.requeries >= self._max_requeries:
+            return dataclasses.replace(
+                memory, collisions=collisions,
+                failure=f"gave up after {memory.requeries} re-queries; {result.reason}")
+        return dataclasses.replace(memory, collisions=collisions,
+                                   requeries=memory.requeries + 1)
+
+    # Outputs.
+    def _memory_of(self, context) -> _Memory:
+        return context.get_abstract_state(self._memory).get_value()
+
+    def _calc_desired_state(self, context, output: BasicVector):
+        memory = self._memory_of(context)
+        if memory.result is None:
+            output.SetFromVector(np.concatenate([memory.q_hold, np.zeros(7)]))
+            return
+        t = context.get_time() - memory.t_plan
+        plan = memory.result.plan
+        output.SetFromVector(np.concatenate([plan.q(t), plan.v(t)]))
+
+    def _calc_wsg_position(self, context, output: BasicVector):
+        memory = self._memory_of(context)
+        if memory.result is None:
+            output.SetAtIndex(0, self._config.open_width)
+            return
+        output.SetAtIndex(0, memory.result.plan.width(context.get_time() - memory.t_plan))
+
+    def _calc_collisions(self, context, output):
+        output.set_value(self._memory_of(context).collisions)
+
+    def _calc_status(self, context, output):
+        memory = self._memory_of(context)
+        common = dict(unreachable_parts=memory.collisions, requeries=memory.requeries,
+                      planning_time=memory.planning_time)
+        if memory.failure:
+            output.set_value(PlanStatus("unreachable", reason=memory.failure, **common))
+            return
+        if memory.result is None:
+            output.set_value(PlanStatus("planning", **common))
+            return
+        plan = memory.result.plan
+        done = context.get_time() - memory.t_plan >= plan.duration
+        output.set_value(PlanStatus("done" if done else "executing", part=plan.part,
+                                    candidate=plan.candidate, X_WG=plan.X_WG_grasp,
+                                    t_plan=memory.t_plan, plan=plan, **common))
+
+
+def _no_candidates() -> GraspCandidates:
+    return GraspCandidates(X_WG=np.zeros((0, 4, 4)), parts=np.zeros(0, int), p_part=np.zeros(0),
+                           p_local=np.zeros(0), score=np.zeros(0))
