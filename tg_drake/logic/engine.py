@@ -381,6 +381,20 @@ def compiled_theory(config: TheoryConfig = TheoryConfig(),
     return _compiled(_key(config, directory))
 
 
+@dataclass
+class LogicQueryConfig:
+    """Parameters of the logic stage (LogicQuerySystem; paper IV and VI)."""
+
+    category: str = "specific"  # category model variant: "specific" or "general".
+    grasp: str = "specific"  # task-dependent grasp model variant: "specific" or "general".
+    exclusive: bool = True  # mutually exclusive outcomes (the paper) or normalised marginals.
+    use_prior: bool = True  # use the kernel's category prior (PLM); False: uniform (PLM_uniform).
+    explain: bool = True  # attach explanations (one batched circuit pass more per query).
+
+    def theory(self) -> TheoryConfig:
+        return TheoryConfig(category=self.category, grasp=self.grasp, exclusive=self.exclusive)
+
+
 class LogicEngine:
     """Answers the three queries for scenes, on a theory compiled once."""
 
@@ -438,5 +452,5 @@ def reference_query(obs: Observations, config: TheoryConfig = TheoryConfig(), *,
     return _answer(obs, joints, evidence, config)
 
 
-__all__ = ["LogicEngine", "LogicAnswer", "CompiledTheory", "compiled_theory", "reference_query",
+__all__ = ["LogicEngine", "LogicQueryConfig", "LogicAnswer", "CompiledTheory", "compiled_theory", "reference_query",
            "QUERIES", "ATOM_TASKS", "OBJECT"]
