@@ -268,6 +268,8 @@ def test_query_row_equals_kernel_matrix_row(database, features, raw_clouds):
         # rtol 1e-12: the same sums in another order.
         np.testing.assert_allclose(database.similarities(c.points, c.normals, c.labels, t=t),
                                    k_hat[t, 3], rtol=1e-12)
+    np.testing.assert_allclose(database.similarity_profile(c.points, c.normals, c.labels),
+                               k_hat[:, 3], rtol=1e-12)
 
 
 def test_prior_of_a_database_member_names_itself_first(database, raw_clouds):

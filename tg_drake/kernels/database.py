@@ -92,14 +92,22 @@ class KernelDatabase:
                 f"needs at least {self.k + 1} points")
         return resampled
 
-    def similarities(self, points, normals, labels, *, t: int | None = None) -> np.ndarray:
-        """(G,) K̂_T between the query cloud and every database graph."""
-        t = self.resolve_iterations(t)
+    def similarity_profile(self, points, normals, labels, *, t: int | None = None
+                           ) -> np.ndarray:
+        """(t + 1, G): K̂_0 .. K̂_t between the query cloud and every database graph
+        (t = None: all T the database holds)."""
+        t = self.t_max if t is None else self.resolve_iterations(t)
         cloud = self.prepare(points, normals, labels)
         hashes = propagation_hashes(cloud_transition(cloud, k=self.k), cloud.labels,
                                     self.projections, t_max=t)
         row, self_k = self.features.cross(hashes)
-        return row[t] / np.sqrt(self_k[t] * self._self_kernels[t])
+        return row / np.sqrt(self_k[:, None] * self._self_kernels[:t + 1])
+
+    def similarities(self, points, normals, labels, *, t: int | None = None) -> np.ndarray:
+        """(G,) K̂_T between the query cloud and every database graph (T = t, or the
+        database's T when t is None)."""
+        t = self.resolve_iterations(t)
+        return self.similarity_profile(points, normals, labels, t=t)[t]
 
     def prior(self, points, normals, labels, *, t: int | None = None,
               n_neighbours: int = N_NEIGHBOURS, exclude_object: str | None = None
