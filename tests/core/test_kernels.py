@@ -190,7 +190,8 @@ def test_normalised_self_kernel_is_maximal(features):
 def test_isomorphic_relabelled_graphs_have_equal_features(clouds, projections):
     c = clouds[2]
     perm = np.random.default_rng(5).permutation(len(c.labels))
-    shuffled = LabelledCloud(c.points[perm], -c.normals[perm], c.labels[perm])  # flipped normals too.
+    # Permuted nodes, and flipped normals too (the weights |n_i · n_j| ignore orientation).
+    shuffled = LabelledCloud(c.points[perm], -c.normals[perm], c.labels[perm])
     h = propagation_hashes(cloud_transition(c), c.labels, projections)
     h_perm = propagation_hashes(cloud_transition(shuffled), shuffled.labels, projections)
     # Same multiset of bins at every t (1e-16 rounding could move a node across a bin edge with

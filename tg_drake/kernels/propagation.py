@@ -152,7 +152,8 @@ class FeatureCounts:
 
 
 def count_features(hashes: np.ndarray, graph_index: np.ndarray, n_graphs: int) -> FeatureCounts:
-    """Counts the bins per graph: `hashes` (T + 1, N) of all nodes, `graph_index` (N,) their graph."""
+    """Counts the bins per graph: `hashes` (T + 1, N) of all nodes, `graph_index` (N,) their
+    graph."""
     vocabularies, counts = [], []
     for bins in hashes:
         vocab, inverse = np.unique(bins, return_inverse=True)
