@@ -7,6 +7,10 @@ counts). The differences to mind:
   graph element; the paper's graph is weighted, so we pass our D⁻¹A.
 - GraKeL draws its projections from a `RandomState`: per t, u = randn(m) / randn(m) (Cauchy, for
   M = "TV") then b = w · rand(). We rebuild the same numbers as an `LshProjections`.
+- GraKeL's `PropagationAttr` would take the distributions as node attributes, but it hashes each
+  of their entries separately (floor((x ⊙ u + b) / w), one bin per dimension) instead of one
+  random projection of the whole distribution, so its features are not the paper's; we compare
+  against `Propagation`, whose hash is the paper's.
 """
 
 from __future__ import annotations
