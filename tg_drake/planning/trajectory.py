@@ -8,7 +8,7 @@ pydrake's `KinematicTrajectoryOptimization` (SNOPT): its duration is minimised s
 - the joint position limits of the plant, the iiwa's velocity limits (scaled by a factor ≤ 1) and
   acceleration limits (`SegmentLimits`);
 - minimum-distance constraints between every unfiltered pair of collision geometries at
-  `collision_samples` evenly spaced path parameters;
+  `collision_samples` evenly spaced interior path parameters;
 - for a straight-line move of the gripper (approach, lift, descent, retreat), the gripper origin
   within `line_tolerance` of the line between its end positions and the gripper orientation
   within `angle_tolerance` of the start orientation, at interior samples.
@@ -122,7 +122,9 @@ def plan_segment(arm: ArmPlant, q0, q1, *, min_distance: float, limits: SegmentL
 
 def _solve_with_refinement(arm, q0, q1, guess_knots, *, min_distance, limits, config, line
                            ) -> Segment:
-    samples = list(np.linspace(0.0, 1.0, config.collision_samples))
+    # Interior samples: the end configurations are fixed and were checked by the IK (whose
+    # accepted solutions may sit a fraction of a millimetre inside the bound).
+    samples = list(np.linspace(0.0, 1.0, config.collision_samples + 2)[1:-1])
     guess = _guess(arm, guess_knots, config.num_control_points, limits)
     for attempt in range(config.max_refinements + 1):
         trajopt, result = _solve(arm, q0, q1, samples, guess, min_distance=min_distance,
