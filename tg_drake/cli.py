@@ -20,6 +20,7 @@ COMMANDS: dict[str, str] = {
     "bench": "tg_drake.bench",
     "objects": "tg_drake.objects",
     "render": "tg_drake.render",
+    "run": "tg_drake.run",
 }
 
 

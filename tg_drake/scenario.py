@@ -180,6 +180,33 @@ class TaskConfig:
     ground_truth: GroundTruth = field(default_factory=GroundTruth)
 
 
+PERCEPTION_MODES = ("depth", "ground_truth")
+THEORY_VARIANTS = ("specific", "general")
+
+
+@dataclass
+class PipelineConfig:
+    """How the stages are set up. Lives in the scenario's `pipeline` block."""
+
+    camera: str = "camera0"  # which camera perception looks through
+    perception: str = "depth"  # "depth": perceive the rendered depth image; "ground_truth":
+    # the object library's labelled surfaces at the true poses (the paper's S_SYN setting)
+    category_theory: str = "specific"  # category model variant: specific | general
+    grasp_theory: str = "specific"  # grasp model variant: specific | general
+    use_prior: bool = True  # the kernel prior feeds the logic (PLM); False: uniform (PLM_uniform)
+    planning_start: float = 0.05  # [s] simulated time of the first planning event
+    max_requeries: int = 3  # re-queries of the logic with collision(Part) evidence
+
+    def validate(self, where: str = "pipeline") -> None:
+        if self.perception not in PERCEPTION_MODES:
+            raise unknown_name("perception mode", self.perception, PERCEPTION_MODES,
+                               error=ScenarioError, field=f"{where}.perception")
+        for name in ("category_theory", "grasp_theory"):
+            if getattr(self, name) not in THEORY_VARIANTS:
+                raise unknown_name("theory variant", getattr(self, name), THEORY_VARIANTS,
+                                   error=ScenarioError, field=f"{where}.{name}")
+
+
 @dataclass
 class Scenario:
     random_seed: int = 0
@@ -193,6 +220,7 @@ class Scenario:
     cameras: dict[str, CameraConfig] = field(default_factory=default_cameras)
     objects: list[ObjectPlacement] = field(default_factory=list)
     task: TaskConfig = field(default_factory=TaskConfig)
+    pipeline: PipelineConfig = field(default_factory=PipelineConfig)
     # Table-top size (x, y) [m] used to check that objects stand on it.
     table_size: list[float] = field(default_factory=lambda: [0.8, 1.2])
     X_WT: Transform = field(default_factory=lambda: _transform(X_WT_DEFAULT))
@@ -297,6 +325,10 @@ def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
             scenario.target_placement()
         except ScenarioError as e:
             raise ScenarioError(e.message, file=where, field="task.target") from None
+    try:
+        scenario.pipeline.validate()
+    except ScenarioError as e:
+        raise ScenarioError(e.message, file=where, field=e.field) from None
     for name, driver in scenario.model_drivers.items():
         if name not in ("iiwa", "wsg"):
             raise unknown_name("model driver", name, ["iiwa", "wsg"], error=ScenarioError,

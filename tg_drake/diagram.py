@@ -1,0 +1,154 @@
+"""The full pipeline as one Drake diagram, built from a scenario.
+
+    builder = DiagramBuilder()
+    pipeline = add_pipeline(builder, scenario=scenario)   # station + every stage, wired
+    diagram = builder.Build()
+
+The same builder is the public way to compose our systems with your own: `add_pipeline` returns
+every system it added (`pipeline.perception`, `.prior`, `.logic`, `.scoring`, `.planner`, and the
+`station`), so you can add systems of yours to the same builder and connect them to any port — or
+call `add_station` alone and wire only the stages you want.
+
+Wiring (DESIGN.md, "The diagram"):
+
+    station camera depth, camera pose ─▶ perception ─▶ target ─▶ scene_description
+    scene_description ─▶ prior ─▶ category_prior
+    scene_description, category_prior, task, collisions ─▶ logic ─▶ grasp_semantics
+    scene_description, grasp_semantics ─▶ scoring ─▶ ranked_grasps
+    scene_description, ranked_grasps, iiwa.state ─▶ planner ─▶ iiwa.desired_state, wsg.position
+    planner.collisions ─▶ logic.collisions   (the closed loop: unreachable parts become evidence)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import ConstantValueSource
+
+from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.scenario import PipelineConfig, Scenario
+from tg_drake.station import Station, add_station, placement_pose
+from tg_drake.targeting import select_target
+from tg_drake.types import SceneDescription
+
+class TargetSelector(LeafSystem):
+    """Marks the task's target among the perceived objects (`tg_drake.targeting.select_target`).
+
+    .. pydrake_system::
+
+        name: TargetSelector
+        input_ports:
+        - scene_description
+        output_ports:
+        - scene_description
+    """
+
+    def __init__(self, p_W_hint):
+        super().__init__()
+        self._hint = np.asarray(p_W_hint, float)
+        model = AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4)))
+        self._in = self.DeclareAbstractInputPort("scene_description", model)
+        self.DeclareAbstractOutputPort(
+            "scene_description", lambda: AbstractValue.Make(
+                SceneDescription(objects=[], X_WT=np.eye(4))), self._calc,
+            prerequisites_of_calc={self.input_port_ticket(self._in.get_index())})
+
+    def _calc(self, context, output):
+        output.set_value(select_target(self._in.Eval(context), self._hint))
+
+
+@dataclass
+class Pipeline:
+    station: Station
+    perception: LeafSystem
+    target: TargetSelector
+    prior: LeafSystem
+    logic: LeafSystem
+    scoring: LeafSystem
+    planner: LeafSystem
+    task: LeafSystem
+    config: PipelineConfig
+    ports: dict = field(default_factory=dict)  # stage output ports by name
+
+
+def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
+                 config: PipelineConfig | None = None) -> Pipeline:
+    """Adds the station and every stage of `scenario` to `builder`, wired as in the module doc."""
+    from tg_drake.kernels.database import KernelPriorConfig
+    from tg_drake.logic.engine import LogicQueryConfig
+    from tg_drake.systems.dgi_system import DgiScoringSystem
+    from tg_drake.systems.grasp_planner import GraspPlanner
+    from tg_drake.systems.kernel_prior_system import KernelPriorSystem
+    from tg_drake.systems.logic_system import LogicQuerySystem
+
+    config = config or scenario.pipeline
+    config.validate()
+    station = add_station(builder, scenario=scenario)
+    target_placement = scenario.target_placement()
+    X_WO_target = placement_pose(scenario, target_placement)
+
+    # Perception: the rendered depth image of one camera, or the library's ground truth.
+    if config.perception == "depth":
+        from tg_drake.systems.perception_system import PerceptionSystem
+
+        if config.camera not in station.cameras:
+            raise unknown_name("camera", config.camera, list(station.cameras),
+                               error=ScenarioError, field="pipeline.camera")
+        perception = builder.AddNamedSystem(
+            "perception", PerceptionSystem(camera_info=station.cameras[config.camera].info))
+        builder.Connect(station.outputs[f"{config.camera}.depth_image"],
+                        perception.GetInputPort("depth_image"))
+        builder.Connect(station.outputs[f"{config.camera}.camera_pose"],
+                        perception.GetInputPort("camera_pose"))
+    else:
+        from tg_drake.systems.perception_system import GroundTruthPerception
+
+        perception = builder.AddNamedSystem("perception", GroundTruthPerception(
+            objects=[(p.id, placement_pose(scenario, p).GetAsMatrix4(), p.containment)
+                     for p in scenario.objects]))
+    target = builder.AddNamedSystem("target", TargetSelector(X_WO_target.translation()))
+    builder.Connect(perception.GetOutputPort("scene_description"), target.get_input_port())
+    scene = target.get_output_port()
+
+    # Category prior, logic, grasp scoring.
+    prior = builder.AddNamedSystem("kernel_prior", KernelPriorSystem(KernelPriorConfig()))
+    builder.Connect(scene, prior.GetInputPort("scene_description"))
+    logic = builder.AddNamedSystem("logic", LogicQuerySystem(LogicQueryConfig(
+        category=config.category_theory, grasp=config.grasp_theory,
+        use_prior=config.use_prior)))
+    task = builder.AddNamedSystem("task", ConstantValueSource(
+        AbstractValue.Make(scenario.task.task)))
+    builder.Connect(scene, logic.GetInputPort("scene_description"))
+    builder.Connect(prior.GetOutputPort("category_prior"), logic.GetInputPort("category_prior"))
+    builder.Connect(task.get_output_port(), logic.GetInputPort("task"))
+    scoring = builder.AddNamedSystem("dgi_scoring", DgiScoringSystem())
+    builder.Connect(scene, scoring.GetInputPort("scene_description"))
+    builder.Connect(logic.GetOutputPort("grasp_semantics"),
+                    scoring.GetInputPort("grasp_semantics"))
+
+    # Planner and execution; the closed loop back to the logic.
+    X_WT = scenario.X_WT.GetDeterministicValue()
+    place_xy_W = (X_WT @ np.array([*scenario.task.place_xy, 0.0, 1.0]))[:2]
+    planner = builder.AddNamedSystem("planner", GraspPlanner(
+        place_xy=place_xy_W, start_time=config.planning_start,
+        max_requeries=config.max_requeries, scenario=scenario))
+    builder.Connect(scene, planner.GetInputPort("scene_description"))
+    builder.Connect(scoring.GetOutputPort("ranked_grasps"), planner.GetInputPort("ranked_grasps"))
+    builder.Connect(station.outputs["iiwa.state"], planner.GetInputPort("iiwa.state"))
+    builder.Connect(planner.GetOutputPort("iiwa.desired_state"),
+                    station.inputs["iiwa.desired_state"])
+    builder.Connect(planner.GetOutputPort("wsg.position"), station.inputs["wsg.position"])
+    builder.Connect(planner.GetOutputPort("collisions"), logic.GetInputPort("collisions"))
+
+    ports = {"scene_description": scene,
+             "category_prior": prior.GetOutputPort("category_prior"),
+             "grasp_semantics": logic.GetOutputPort("grasp_semantics"),
+             "ranked_grasps": scoring.GetOutputPort("ranked_grasps"),
+             "plan_status": planner.GetOutputPort("plan_status"),
+             "collisions": planner.GetOutputPort("collisions")}
+    return Pipeline(station=station, perception=perception, target=target, prior=prior,
+                    logic=logic, scoring=scoring, planner=planner, task=task, config=config,
+                    ports=ports)
