@@ -214,20 +214,23 @@ class Observations:
 
 
 def count_handles(obj: ObjectDescription) -> int:
-    """1 or 2: whether the handle points sit on one side of the symmetry axis or on two opposite
-    sides (a pot's pair of handles).
-
-    The directions from the object's z axis to the handle points, in the object's xy plane, are
-    averaged as unit vectors: one handle gives a mean resultant length near 1, two opposite
-    handles near 0. The split at 0.5 is where a second, equal cluster at more than 120° from the
-    first would pull the mean below it.
-    """
-    handle = np.asarray(obj.labels) == part_index("handle")
-    if not handle.any():
-        return 1
+    """1 or 2 handles on a perceived object (`handle_count` on its cloud in its own frame)."""
     X_WO = np.asarray(obj.X_WO, dtype=float)
-    p_O = (np.asarray(obj.p_W, dtype=float)[handle] - X_WO[:3, 3]) @ X_WO[:3, :3]
-    d = p_O[:, :2]
+    p_O = (np.asarray(obj.p_W, dtype=float) - X_WO[:3, 3]) @ X_WO[:3, :3]
+    return handle_count(p_O, np.asarray(obj.labels))
+
+
+def handle_count(p_O: np.ndarray, labels: np.ndarray) -> int:
+    """1 or 2: whether the handle points sit on one side of the object's z (symmetry) axis or
+    on two opposite sides (a pot's pair of handles). p_O: (N, 3) points in the object frame.
+
+    The directions from the z axis to the handle points, in the xy plane, are averaged as unit
+    vectors: one handle gives a mean resultant length near 1, two opposite handles near 0. The
+    split at 0.5 is where a second, equal cluster at more than 120° from the first would pull the
+    mean below it.
+    """
+    handle = np.asarray(labels) == part_index("handle")
+    d = np.asarray(p_O, dtype=float)[handle][:, :2]
     norm = np.linalg.norm(d, axis=1)
     d = d[norm > 0] / norm[norm > 0, None]
     if len(d) == 0:
