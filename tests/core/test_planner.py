@@ -148,6 +148,16 @@ def test_max_parts_tries_only_the_leading_part():
     assert (r.candidate, r.part) == (2, "top")
 
 
+def test_unreachable_place_is_not_a_collision_of_the_part():
+    c = candidates([(TOP, "top")])
+    r = plan_pick_and_place(c, target=BOX, place_xy=(1.6, 0.0))
+    assert r.status == "unreachable"
+    assert r.unreachable_parts == ()  # the top can be picked: no collision(top) evidence
+    assert r.part_reachable == {"top": True}
+    assert r.candidate_reasons[0].startswith("pre-place pose unreachable")
+    assert "picked but not placed" in r.reason
+
+
 def test_part_wider_than_the_opening_is_infeasible():
     wide = box_object([0.75, 0.1, 0.06], [0.07, 0.16, 0.12])
     c = candidates([(grasp_pose([0.75, 0.1, 0.09], [0, 0, -1], [0, 1, 0]), "top")])

@@ -174,6 +174,18 @@ def test_gives_up_after_max_requeries():
     assert s.reason.startswith("gave up after 0 re-queries")
 
 
+def test_unreachable_place_gives_up_without_blaming_the_part():
+    planner = GraspPlanner(place_xy=(1.6, 0.0), start_time=0.0)
+    context = fixed_inputs(planner, SCENE, ranked([(TOP, "top")]))
+    simulator = Simulator(planner, context)
+    simulator.Initialize()
+    simulator.AdvanceTo(0.01)
+    s = status(planner, context)
+    assert (s.status, s.unreachable_parts, s.requeries) == ("unreachable", (), 0)
+    assert "picked but not placed" in s.reason
+    assert planner.get_collisions_output_port().Eval(context) == ()
+
+
 class _RankerWithoutCollisions(LeafSystem):
     """A stand-in for the logic + DGI: the given candidates without those of parts in
     `collisions` (as collision(Part) evidence sets their probability to 0); counts its calls."""

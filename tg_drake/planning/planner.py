@@ -26,8 +26,12 @@ densely); approach, lift, descent and retreat are straight-line moves of the gri
 
 The first candidate for which everything succeeds is chosen. A failure is a result, not an
 exception: `PlanResult(status="unreachable", unreachable_parts=..., reason=...)`, and every
-candidate found infeasible gets cost inf. The parts for which no candidate gave a plan are what the
-logic receives as `collision(Part)` evidence (`tg_drake.systems.grasp_planner`).
+candidate found infeasible gets cost inf. A candidate fails on the pick side (its pre-grasp,
+grasp or lift pose, or the motions to and through them) or on the place side (pre-place, place,
+retreat). The parts none of whose candidates can even be picked are `unreachable_parts`: what the
+logic receives as `collision(Part)` evidence (`tg_drake.systems.grasp_planner`). A part that can
+be picked but not placed is not a collision of that part: the place target is the problem, and
+the result says so.
 
 Obstacles are the perceived objects' bounding boxes (`ObjectDescription.X_WO`, `extents`); the
 held object is its bounding box welded to the gripper.
@@ -127,7 +131,7 @@ class PlanResult:
     # not examined (a better candidate was chosen first, or its part was not tried).
     candidate_reasons: tuple  # (M,) why each infeasible candidate failed ("" otherwise)
     part_reachable: dict  # examined part name → whether any of its pre-grasps had an IK solution
-    unreachable_parts: tuple  # examined parts none of whose candidates gave a plan
+    unreachable_parts: tuple  # examined parts none of whose candidates can be picked
     reason: str = ""
     planning_time: float = 0.0  # [s] wall time
     candidate: int | None = None
@@ -180,7 +184,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
     costs = np.full(m, np.nan)
     reasons = [""] * m
     part_reachable: dict[str, bool] = {}
-    part_planned: dict[str, bool] = {}
+    part_pickable: dict[str, bool] = {}
 
     # Candidates in order of score, grouped into the parts to try.
     order = np.argsort(-np.asarray(candidates.score, float), kind="stable")
@@ -214,7 +218,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             continue
         tried[part] += 1
         part_reachable.setdefault(part, False)
-        part_planned.setdefault(part, False)
+        part_pickable.setdefault(part, False)
         score = float(candidates.score[i])
         if not np.isfinite(score) or score <= 0.0:
             costs[i], reasons[i] = np.inf, "score 0: ruled out"
@@ -234,27 +238,41 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         if "pre-grasp" in poses:
             part_reachable[part] = True
         if failure:
+            # Failing on a place pose, the pick poses were reachable (their motions untried).
+            part_pickable[part] |= PICK_POSES <= set(poses)
             costs[i], reasons[i] = np.inf, failure
             continue
-        plan, failure = _trajectories(arms, q_start, poses, key, config, seeds,
-                                      candidate=int(i), part=part)
+        plan, failure, picked = _trajectories(arms, q_start, poses, key, config, seeds,
+                                              candidate=int(i), part=part)
+        part_pickable[part] |= picked
         if plan is None:
             costs[i], reasons[i] = np.inf, failure
             continue
         costs[i] = -np.log(score)
-        part_planned[part] = True
         break
 
     elapsed = time.perf_counter() - t_start
-    unreachable = tuple(p for p in parts_order if p in part_planned and not part_planned[p])
+    unreachable = tuple(p for p in parts_order if p in part_pickable and not part_pickable[p])
     if plan is None:
         examined = [r for r in reasons if r]
-        reason = ("no candidate of " + ", ".join(unreachable) + " can be executed; first "
-                  "failure: " + (examined[0] if examined else "none examined"))
+        first = examined[0] if examined else "none examined"
+        if unreachable:
+            reason = f"no candidate of {', '.join(unreachable)} can be picked; first failure: {first}"
+        else:
+            place_failures = [r for r in examined if r.startswith(PLACE_FAILURES)]
+            reason = ("the object can be picked but not placed at "
+                      f"{tuple(np.round(place_xy, 3))}: " + (place_failures or [first])[0])
         return PlanResult("unreachable", None, costs, tuple(reasons), part_reachable,
                           unreachable, reason, elapsed)
     return PlanResult("planned", plan, costs, tuple(reasons), part_reachable, unreachable, "",
                       elapsed, plan.candidate, plan.part)
+
+
+# The key poses and motions of the pick; failures after them are the place's.
+PICK_POSES = {"pre-grasp", "grasp", "lift"}
+PICK_MOTIONS = ("move", "approach", "lift")
+PLACE_FAILURES = ("pre-place pose", "place pose", "retreat pose", "carry trajectory",
+                  "descend trajectory", "retreat trajectory")  # how their reasons start
 
 
 class _Arms:
@@ -381,8 +399,8 @@ def _line(key: _KeyPoses, a: str, b: str) -> StraightLine:
 
 def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *, candidate,
                   part):
-    """The segments between the key configurations, assembled into a Plan: (Plan, "") or
-    (None, reason)."""
+    """The segments between the key configurations, assembled into a Plan: (Plan, "", True) or
+    (None, reason, whether the pick motions were found)."""
     c = config
     carry = arms.carry(key.X_GO)
     # name, from, to, plant, clearance, limits, straight line or None (free: via-point guesses)
@@ -404,7 +422,7 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
         segment = plan_segment(arm, q[a], q[b], min_distance=min_distance, limits=limits,
                                config=c.segment, line=line, via=seeds if line is None else ())
         if not segment.success:
-            return None, f"{name} trajectory: {segment.reason}"
+            return None, f"{name} trajectory: {segment.reason}", name not in PICK_MOTIONS
         solved[name] = segment
 
     # The timeline: move, approach, close, lift, carry, descend, open, retreat.
@@ -447,4 +465,4 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
                 t_place_done=t_place_done, duration=t, candidate=candidate, part=part,
                 X_WG_grasp=key.X["grasp"].GetAsMatrix4(),
                 X_WO_place=key.X_WO_place, waypoints=q, segments=tuple(rows))
-    return plan, ""
+    return plan, "", True
