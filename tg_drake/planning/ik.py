@@ -112,7 +112,8 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
         fingers = GeometrySet([g for n in ("left_finger", "right_finger")
                                for g in plant.GetCollisionGeometriesForBody(
                                    plant.GetBodyByName(n, wsg))])
-        objects = GeometrySet([g for b in touchable for g in plant.GetCollisionGeometriesForBody(b)])
+        objects = GeometrySet([g for b in touchable
+                               for g in plant.GetCollisionGeometriesForBody(b)])
         manager.Apply(CollisionFilterDeclaration().ExcludeBetween(fingers, objects))
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()

@@ -15,7 +15,7 @@ solutions, inside the joint limits and clear of collisions, for
     lift        X_WG raised `lift_height`                           (the target is in the hand)
     pre-place   the place pose raised `lift_height`                 (in the hand)
     place       X_WG carried with the object to X_WO_place          (in the hand)
-    retreat     the place pose moved `retreat_distance` along −y_G  (the target stands at the place)
+    retreat     the place pose moved `retreat_distance` along −y_G  (the target at the place)
 
 where X_WO_place is the object's pose X_WO moved to the place target's xy, its orientation kept,
 and raised so that its box's lowest corner is `release_height` above the table. The IK is local,
@@ -125,6 +125,8 @@ class Plan:
 
 @dataclass(frozen=True)
 class PlanResult:
+    """What `plan_pick_and_place` found: a plan, or why there is none."""
+
     status: str  # "planned" or "unreachable"
     plan: Plan | None
     costs: np.ndarray  # (M,) per candidate: −log(score) if chosen, inf if infeasible, nan if
@@ -257,7 +259,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         examined = [r for r in reasons if r]
         first = examined[0] if examined else "none examined"
         if unreachable:
-            reason = f"no candidate of {', '.join(unreachable)} can be picked; first failure: {first}"
+            reason = (f"no candidate of {', '.join(unreachable)} can be picked; first failure: "
+                      + first)
         else:
             place_failures = [r for r in examined if r.startswith(PLACE_FAILURES)]
             reason = ("the object can be picked but not placed at "

@@ -15,10 +15,10 @@ pydrake's `KinematicTrajectoryOptimization` (SNOPT): its duration is minimised s
 
 Constraints at samples say nothing about the path between them, so the solution is then checked
 densely (at times no joint moves more than `check_step` between). Where the clearance falls below
-`check_fraction` · `min_distance`, a minimum-distance constraint is added at that path parameter and
-the problem is solved again from the previous solution, up to `max_refinements` times.
+`check_fraction` · `min_distance`, a minimum-distance constraint is added at that path parameter
+and the problem is solved again from the previous solution, up to `max_refinements` times.
 
-The iiwa's two WSG finger joints are part of the arm plant's positions; they are held at the arm
+The WSG's two finger joints are part of the arm plant's positions; they are held at the arm
 plant's opening (equal lower and upper bounds) and dropped from the returned trajectory, which
 has the 7 iiwa joints as its rows.
 """
