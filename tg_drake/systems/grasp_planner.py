@@ -1,4 +1,4 @@
-"""The grasp planner as a Drake system, closing the loop with the logic (paper sections IV-D and VI).
+"""The grasp planner as a Drake system, closing the loop with the logic (paper IV-D and VI).
 
 The paper's constraint `false :- grasp(X, T, R), part(R, X), collision(R).` connects the reasoning
 module to the execution planner: a part the gripper cannot reach becomes `collision(Part)`
