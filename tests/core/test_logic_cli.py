@@ -46,3 +46,12 @@ def test_malformed_observations_file_is_a_clear_error(tmp_path, capsys):
     assert main(["query", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "bad.yaml" in err and "field 'task'" in err and "unknown task 'pour'" in err
+
+
+def test_bench_figure_is_registered():
+    import importlib
+
+    from tg_drake.bench import FIGURES
+
+    module, function = FIGURES["logic_scene_ms"].split(":")
+    assert callable(getattr(importlib.import_module(module), function))

@@ -43,7 +43,7 @@ from problog.program import SimpleProgram
 
 from tg_drake.errors import RuleError
 from tg_drake.logic.circuit import Circuit
-from tg_drake.logic.names import ATOM_TASKS, OBJECT, TASK_ATOMS
+from tg_drake.logic.names import TASK_ATOMS
 from tg_drake.logic.observations import (
     PLACEHOLDER,
     SCHEMA_PARAMETERS,
@@ -265,8 +265,8 @@ class CompiledTheory:
             if self.clauses[k].explains:
                 rule_rows.setdefault(k, []).append(row)
 
-        # Static reasons: every explaining rule (its switch row). Observation reasons are built
-        # per scene (their text carries the scene's values).
+        # Static reasons: every rule of a reasoning file (its switch or choice rows).
+        # Observation reasons are built per scene (their text carries the scene's values).
         self.rule_reasons = [(f"{self.clauses[k].text}  [{self.clauses[k].where}]", rows,
                               self.clauses[k].file) for k, rows in sorted(rule_rows.items())]
         self.n_params = len(self.base)
@@ -452,5 +452,5 @@ def reference_query(obs: Observations, config: TheoryConfig = TheoryConfig(), *,
     return _answer(obs, joints, evidence, config)
 
 
-__all__ = ["LogicEngine", "LogicQueryConfig", "LogicAnswer", "CompiledTheory", "compiled_theory", "reference_query",
-           "QUERIES", "ATOM_TASKS", "OBJECT"]
+__all__ = ["LogicEngine", "LogicQueryConfig", "LogicAnswer", "CompiledTheory", "compiled_theory",
+           "reference_query", "QUERIES"]

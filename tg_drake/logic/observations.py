@@ -339,7 +339,7 @@ def observation_schema() -> tuple[list[Term], dict[Term, int]]:
 
 def observation_clauses(obs: Observations) -> list[Term]:
     """The scene as a plain ProbLog program: facts with their probabilities and the annotated
-    disjunctions themselves (the paper's form, e.g. 0.56::cup(o); 0.36::can(o); ... <- object(o))."""
+    disjunctions themselves (the paper's form: 0.56::cup(o); 0.36::can(o); ... <- object(o))."""
     o = _o()
     clauses: list[Term] = [Term("object", o)]
 
