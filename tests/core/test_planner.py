@@ -158,6 +158,16 @@ def test_unreachable_place_is_not_a_collision_of_the_part():
     assert "picked but not placed" in r.reason
 
 
+def test_zero_scores_are_ruled_out_not_unreachable():
+    """A part the logic gave probability 0 is skipped without blaming its reach."""
+    c = candidates([(SIDE, "middle"), (TOP, "top")], scores=[0.0, 0.0])
+    r = plan_pick_and_place(c, target=BOX, place_xy=(0.75, -0.25))
+    assert r.status == "unreachable"
+    assert r.unreachable_parts == () and r.part_reachable == {}
+    assert np.all(np.isinf(r.costs))
+    assert all(reason.startswith("score 0") for reason in r.candidate_reasons)
+
+
 def test_part_wider_than_the_opening_is_infeasible():
     wide = box_object([0.75, 0.1, 0.06], [0.07, 0.16, 0.12])
     c = candidates([(grasp_pose([0.75, 0.1, 0.09], [0, 0, -1], [0, 1, 0]), "top")])

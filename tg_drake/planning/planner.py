@@ -188,8 +188,14 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
     part_reachable: dict[str, bool] = {}
     part_pickable: dict[str, bool] = {}
 
-    # Candidates in order of score, grouped into the parts to try.
-    order = np.argsort(-np.asarray(candidates.score, float), kind="stable")
+    # Candidates in order of score, grouped into the parts to try. A score of 0 means the logic
+    # or the grasp model ruled the candidate out: it is infeasible, but says nothing about reach.
+    score = np.asarray(candidates.score, float)
+    viable = np.isfinite(score) & (score > 0.0)
+    costs[~viable] = np.inf
+    for i in np.flatnonzero(~viable):
+        reasons[i] = "score 0: ruled out by the logic or the grasp model"
+    order = [i for i in np.argsort(-score, kind="stable") if viable[i]]
     parts_order = []
     for i in order:
         name = PART_LABELS[int(candidates.parts[i])]
@@ -221,10 +227,6 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         tried[part] += 1
         part_reachable.setdefault(part, False)
         part_pickable.setdefault(part, False)
-        score = float(candidates.score[i])
-        if not np.isfinite(score) or score <= 0.0:
-            costs[i], reasons[i] = np.inf, "score 0: ruled out"
-            continue
         X_WG = np.asarray(candidates.X_WG[i], float)
         width = _part_width(target, part, X_WG)
         if width > config.open_width - config.width_margin:
@@ -250,7 +252,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         if plan is None:
             costs[i], reasons[i] = np.inf, failure
             continue
-        costs[i] = -np.log(score)
+        costs[i] = -np.log(score[i])
         break
 
     elapsed = time.perf_counter() - t_start
