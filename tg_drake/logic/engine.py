@@ -117,9 +117,11 @@ class LogicAnswer:
             target=target)
 
 
-def _normalise(joint: np.ndarray) -> np.ndarray:
-    total = joint.sum()
-    return joint / total if total > EVIDENCE_FLOOR else np.zeros_like(joint)
+def _normalise(conditional: np.ndarray) -> np.ndarray:
+    """P(q | e) over the outcomes, divided by their sum; all zeros when no outcome is possible
+    (every grasp ruled out): a sum below EVIDENCE_FLOOR is float noise around 0."""
+    total = conditional.sum()
+    return conditional / total if total > EVIDENCE_FLOOR else np.zeros_like(conditional)
 
 
 def _answer(obs: Observations, joints: dict[str, np.ndarray], evidence: float,
@@ -329,14 +331,18 @@ class CompiledTheory:
         batch = np.repeat(params[:, None], len(reasons) + 1, axis=1)
         for j, (_, rows, _) in enumerate(reasons):
             batch[rows, j + 1] = 0.0
-        joints, _ = self.split(self.evaluate(batch))
+        joints, evidence = self.split(self.evaluate(batch))
+        # Without a reason the evidence may become impossible: that column then answers 0.
+        scale = np.where(evidence > EVIDENCE_FLOOR, 1.0 / np.maximum(evidence, EVIDENCE_FLOOR),
+                         0.0)
         out = {}
         for q in QUERIES:
             if q == "task" and obs.task is not None:
                 continue
-            totals = joints[q].sum(axis=0)
+            conditional = joints[q] * scale
+            totals = conditional.sum(axis=0)
             with np.errstate(divide="ignore", invalid="ignore"):
-                normalised = np.where(totals > EVIDENCE_FLOOR, joints[q] / totals, 0.0)
+                normalised = np.where(totals > EVIDENCE_FLOOR, conditional / totals, 0.0)
             probabilities = getattr(answer, q)
             order = [i for i in np.argsort(-probabilities, kind="stable")[:MAX_ANSWERS]
                      if probabilities[i] > 0]
@@ -406,6 +412,8 @@ class LogicEngine:
     def query(self, obs: Observations, *, explain: bool = False) -> LogicAnswer:
         params = self.theory.parameters(obs)
         joints, evidence = self.theory.split(self.theory.evaluate(params))
+        if evidence > EVIDENCE_FLOOR:  # P(q | e), as the reference path gets from ProbLog.
+            joints = {q: v / evidence for q, v in joints.items()}
         answer = _answer(obs, joints, float(evidence), self.config)
         if explain:
             answer.explanations = self.theory.explain(obs, params, answer)
