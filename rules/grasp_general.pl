@@ -1,6 +1,6 @@
 % Task-dependent grasp model, general variant (paper IV-C): the specific model generalised over pose
 % and containment and over related tasks (pour = pourIn, pourOut; place = p&pIn, p&pOn), so far
-% fewer rules. The dish/pass block is the paper's; the rest are ours (rules/README.md, table 5).
+% fewer rules. The dish/pass block is the paper's; the rest are ours (rules/README.md, table 6).
 
 
 % ---- dish ----

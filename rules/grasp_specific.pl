@@ -2,7 +2,7 @@
 % for a task, given the object's super-category, pose and containment. One block per super-category
 % (the four that partition the categories: dish, kitchen_container, canister, tool) and task; the
 % causal probability is how suitable the part is. Blocks marked "paper" are the paper's; the rest are
-% ours (rules/README.md, table 4). A part is only grasped if it was observed (part/2 in the body).
+% ours (rules/README.md, table 5). A part is only grasped if it was observed (part/2 in the body).
 
 
 % ---- dish (cup, glass, bowl) ----
