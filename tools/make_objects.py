@@ -71,6 +71,9 @@ MATERIALS = {
     "plastic": (1100.0, (0.85, 0.20, 0.15)),
     "pet": (1380.0, (0.55, 0.80, 0.70)),
     "air": (0.0, (0.0, 0.0, 0.0)),
+    # knife handles: scales around a full steel tang (about a quarter of the handle's volume)
+    "wood_tang": (0.75 * 700.0 + 0.25 * 7900.0, (0.45, 0.30, 0.18)),
+    "plastic_tang": (0.75 * 1100.0 + 0.25 * 7900.0, (0.12, 0.12, 0.12)),
 }
 
 # Suitable poses per category and the pose's "down" direction in the object frame. Bottles do not
@@ -90,9 +93,10 @@ DOWN = {"upright": (0.0, 0.0, -1.0), "upsidedown": (0.0, 0.0, 1.0), "sideways": 
 TOOL_DOWN = (0.0, 0.0, -1.0)
 MAX_TILT = math.radians(35.0)  # a resting face further than this from "down" is another pose.
 # An object whose COM projects less than this inside the face it stands on tips over the nearest
-# edge. A facet strip of a tessellated round wall is 4–7 mm wide: a COM within 1 mm of its edge
-# means the object is rolling on a cylinder (a mug on its side rolls until the handle touches).
-ROLL_MARGIN = 0.001
+# edge. A facet strip of a tessellated round wall is 4–7 mm wide, and the compliant table lets the
+# object rock over an edge: in simulation a mug on its side whose COM was 1.2 mm inside its strip
+# rolled until its handle touched, as a real one does.
+ROLL_MARGIN = 0.002
 DECIMALS = 6  # vertex coordinates are written with 1 µm resolution.
 
 
@@ -241,6 +245,30 @@ def superellipse(n: int, a, b, p=2.0, phase=0.0, flutes=0, flute_depth=0.0):
     return np.stack([a * np.sign(c) * np.abs(c) ** e * r, b * np.sign(s) * np.abs(s) ** e * r], 1)
 
 
+def rounded_rect(n: int, a, b, rc):
+    """(n, 2) points (n a multiple of 4) of a rectangle ±a × ±b with corners rounded to radius rc,
+    anticlockwise from (a, 0), spaced evenly along the perimeter with a point on each end of every
+    straight side (so a side is exactly flat, as wide as it really is)."""
+    k = n // 4
+    if 4 * k != n:
+        raise ValueError("rounded_rect needs a multiple of 4 points")
+    L1, L2 = b - rc, b - rc + np.pi * rc / 2  # quadrant path: side, arc, top side
+    L = L2 + a - rc
+    s = np.arange(k) * L / k
+    for t in (L1, L2):  # snap the nearest free sample onto each tangent point
+        free = np.arange(1, k)
+        i = free[np.argmin(np.abs(s[free] - t))]
+        s[i] = t
+    s = np.sort(s)
+    phi = np.clip((s - L1) / max(rc, 1e-12), 0, np.pi / 2)
+    q = np.where((s <= L1)[:, None], np.stack([np.full(k, a), s], 1),
+                 np.where((s <= L2)[:, None],
+                          np.stack([a - rc + rc * np.cos(phi), b - rc + rc * np.sin(phi)], 1),
+                          np.stack([a - rc - (s - L2), np.full(k, b)], 1)))
+    q2 = np.concatenate([[[0.0, b]], q[:0:-1] * [-1, 1]])
+    return np.concatenate([q, q2, -q, -q2])
+
+
 def bezier(P0, P1, P2, P3, t):
     t = np.asarray(t)[:, None]
     return ((1 - t) ** 3 * P0 + 3 * (1 - t) ** 2 * t * P1 + 3 * (1 - t) * t ** 2 * P2
@@ -262,14 +290,16 @@ def arclength_samples(curve, n_dense=2000):
     return s[-1], f
 
 
-def resample(poly: np.ndarray, key: np.ndarray, h: float) -> np.ndarray:
-    """Resamples a dense 2-D polyline with at most `h` between points, keeping every key point."""
+def resample(poly: np.ndarray, key: np.ndarray, h: float, h_from=None) -> np.ndarray:
+    """Resamples a dense 2-D polyline with at most `h` between points, keeping every key point.
+    h_from[i] (if finite) overrides h for the piece that starts at key point i."""
     ks = np.flatnonzero(key)
     out = []
     for k0, k1 in zip(ks[:-1], ks[1:]):
         sub = poly[k0:k1 + 1]
         s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(sub, axis=0), axis=1))])
-        m = max(1, math.ceil(s[-1] / h - 1e-9))
+        hk = h if h_from is None or not np.isfinite(h_from[k0]) else h_from[k0]
+        m = max(1, math.ceil(s[-1] / hk - 1e-9))
         sv = np.linspace(0.0, s[-1], m + 1)[:-1]
         out.append(np.stack([np.interp(sv, s, sub[:, 0]), np.interp(sv, s, sub[:, 1])], 1))
     out.append(poly[-1:])
@@ -282,21 +312,26 @@ class Profile:
     def __init__(self):
         self.pts: list[np.ndarray] = []
         self.key: list[np.ndarray] = []
+        self.h: list[np.ndarray] = []
 
-    def add(self, pts, keys=None):
+    def add(self, pts, keys=None, h=np.inf):
         pts = np.asarray(pts, float).reshape(-1, 2)
         k = np.zeros(len(pts), bool)
         k[[0, -1]] = True
         if keys is not None:
             k |= keys
+        hh = np.full(len(pts), float(h))
         if self.pts and np.allclose(self.pts[-1][-1], pts[0]):
-            pts, k = pts[1:], k[1:]
             self.key[-1][-1] = True
+            self.h[-1][-1] = hh[0]
+            pts, k, hh = pts[1:], k[1:], hh[1:]
         self.pts.append(pts)
         self.key.append(k)
+        self.h.append(hh)
 
-    def line(self, p0, p1):
-        self.add(np.array([p0, p1], float))
+    def line(self, p0, p1, h=np.inf):
+        """A straight piece; h: its own maximum point spacing (default: the profile's)."""
+        self.add(np.array([p0, p1], float), h=h)
 
     def curve(self, f, u0, u1, z_keys=(), n=600):
         """Adds f(u) for u in [u0, u1]; points with z in z_keys (found on the dense curve) are keys."""
@@ -340,7 +375,8 @@ class Profile:
         self.add(pts)
 
     def resampled(self, h: float) -> np.ndarray:
-        return resample(np.concatenate(self.pts), np.concatenate(self.key), h)
+        return resample(np.concatenate(self.pts), np.concatenate(self.key), h,
+                        np.concatenate(self.h))
 
 
 def revolve(profile: np.ndarray, n: int, *, p=2.0, R=np.eye(3), origin=np.zeros(3)):
@@ -504,61 +540,95 @@ def rot_to(n, target):
     return np.eye(3) + math.sin(ang) * Kx + (1 - math.cos(ang)) * Kx @ Kx
 
 
+PLANE_TOL = 2e-6  # [m] a hull vertex this close to a face's plane rests on the table with it
+# (vertices are rounded to 1 µm).
+
+
 def _support(hull, f, com):
-    """The hull face containing facet f (its coplanar facets merged) and the COM's projection onto
-    it: (facet ids, outward normal, margin [m] of the COM inside the support polygon (negative
-    outside), hull-vertex ids on the polygon edge the COM is nearest to)."""
-    eq = hull.equations
-    n, off = eq[f, :3], eq[f, 3]
-    group = np.flatnonzero((np.abs(eq[:, :3] - n).max(1) < 1e-4) & (np.abs(eq[:, 3] - off) < 2e-6))
-    verts = np.unique(hull.simplices[group])
-    pts = hull.points[verts]
+    """The support polygon when the object stands on hull facet f: every hull vertex on f's plane.
+
+    Returns (vertex ids on the plane, outward normal, the plane's 2-D basis (u, w), the polygon's
+    edge lines in that basis (E, 3), the hull-vertex ids on each edge, the distance of the COM's
+    projection inside each edge [m] (negative: outside))."""
+    n, off = hull.equations[f, :3], hull.equations[f, 3]
+    hv = hull.vertices
+    verts = hv[np.abs(hull.points[hv] @ n + off) < PLANE_TOL]
     u = np.cross(n, [0, 0, 1.0]) if abs(n[2]) < 0.9 else np.cross(n, [1.0, 0, 0])
     u /= np.linalg.norm(u)
     w = np.cross(n, u)
-    q = np.stack([pts @ u, pts @ w], 1)
+    q = hull.points[verts] @ np.stack([u, w], 1)
     h2 = ConvexHull(q)
-    d = h2.equations[:, :2] @ np.array([com @ u, com @ w]) + h2.equations[:, 2]
-    k = int(np.argmax(d))
-    on_edge = np.abs(q @ h2.equations[k, :2] + h2.equations[k, 2]) < 1e-7
-    return group, n, -float(d[k]), verts[on_edge]
+    inside = -(h2.equations[:, :2] @ np.array([com @ u, com @ w]) + h2.equations[:, 2])
+    edges = []
+    for k, line in enumerate(h2.equations):
+        on = np.abs(q @ line[:2] + line[2]) < PLANE_TOL
+        on[h2.simplices[k]] = True
+        edges.append(verts[on])
+    return verts, n, (u, w), h2.equations, edges, inside
+
+
+def _across(hull, f, basis, line, edge):
+    """The face the object lands on when it tips over an edge of its support polygon on facet f.
+
+    Rotating about the edge line, a hull vertex at height h above the table and d beyond the edge
+    touches down after atan2(h, d): the first to touch fixes the new plane, whose outward normal is
+    n0·cos θ + t·sin θ (t: the edge's outward direction in the old plane). Returns (the hull facet
+    in that plane, its normal, its offset)."""
+    n0, off0 = hull.equations[f, :3], hull.equations[f, 3]
+    t = line[0] * basis[0] + line[1] * basis[1]
+    P = hull.points[hull.vertices]
+    a = hull.points[edge[0]]
+    d = (P - a) @ t
+    h = -(P @ n0 + off0)
+    beyond = d > PLANE_TOL
+    if not beyond.any():
+        return None
+    theta = np.arctan2(h[beyond], d[beyond]).min()
+    n1 = math.cos(theta) * n0 + math.sin(theta) * t
+    face = int(np.argmax(hull.equations[:, :3] @ n1))
+    return face, n1, -float(n1 @ a)
 
 
 def resting_face(V, com, down, max_tilt=MAX_TILT):
     """The convex-hull face the object comes to rest on when put down with `down` (object frame)
     towards the table.
 
-    Starts on the hull face closest to `down` and, while the COM projects less than ROLL_MARGIN
-    inside its support polygon, tips over the polygon edge nearest to the COM onto the next face
-    (a mug on its side rolls until its handle touches). If it comes back to a face it has left
-    (a barrel-shaped wall curved along its axis, made of narrow facet strips), it settles on the
-    face of that cycle with the largest margin. Returns (outward unit normal, margin [m]); raises
-    if the face reached is more than `max_tilt` from `down` (the pose does not suit the object).
+    Starts on the hull face closest to `down` and tips over edges of its support polygon: over the
+    edge the COM projects beyond, if any; else over an edge the COM projects less than
+    ROLL_MARGIN inside of, when the face beyond lowers the COM (a mug on its side rolls until its
+    handle touches; a barrel-shaped wall made of narrow facet strips stays on the strip under its
+    COM, the lowest). The COM's height drops at every roll, so the walk ends. Returns (outward
+    unit normal, margin [m] of the COM inside the final support polygon); raises if that face is
+    more than `max_tilt` from `down` (the pose does not suit the object).
     """
     hull = ConvexHull(V)
     down = np.asarray(down, float)
     f = int(np.argmax(hull.equations[:, :3] @ down))
-    visited = []  # (first facet id of the face, normal, margin)
-    while True:
-        group, n, margin, edge = _support(hull, f, com)
-        key = int(group.min())
-        keys = [v[0] for v in visited]
-        if key in keys:
-            cycle = visited[keys.index(key):]
-            _, n, margin = max(cycle, key=lambda v: v[2])
+
+    def height(n, off):  # of the COM above a plane (scipy: n·x + off <= 0 inside)
+        return -(n @ com + off)
+
+    for _ in range(len(hull.simplices)):
+        verts, n, basis, lines, edges, inside = _support(hull, f, com)
+        if inside.min() < 0:  # the COM is outside: it tips over that edge
+            k = int(np.argmin(inside))
+            nxt = _across(hull, f, basis, lines[k], edges[k])
+            if nxt is None:
+                raise RuntimeError("hull walk found no face across the tipping edge")
+            f = nxt[0]
+            continue
+        options = []
+        h0 = height(hull.equations[f, :3], hull.equations[f, 3])
+        for k in np.flatnonzero(inside < ROLL_MARGIN):
+            nxt = _across(hull, f, basis, lines[k], edges[k])
+            if nxt is not None and height(nxt[1], nxt[2]) < h0 - 1e-9:
+                options.append((height(nxt[1], nxt[2]), nxt[0]))
+        if not options:
             break
-        visited.append((key, n, margin))
-        if margin >= ROLL_MARGIN:
-            break
-        # tip over the edge: the next face shares at least two of the edge's hull vertices
-        shared = np.isin(hull.simplices, edge).sum(1) >= 2
-        shared[group] = False
-        cand = np.flatnonzero(shared)
-        if len(cand) == 0:
-            raise RuntimeError("hull walk found no face across the tipping edge")
-        f = int(cand[np.argmax(hull.equations[cand, :3] @ n)])
-    if margin <= 0:
-        raise RuntimeError(f"no stable resting face towards {down.tolist()}")
+        f = min(options)[1]
+    else:
+        raise RuntimeError("hull walk did not settle")
+    margin = float(inside.min())
     if n @ down < math.cos(max_tilt):
         raise RuntimeError(f"put down towards {down.tolist()}, the object rolls to a face "
                            f"{math.degrees(math.acos(np.clip(n @ down, -1, 1))):.0f}° away")
@@ -612,8 +682,9 @@ def thirds_labels(z, H):
 def open_profile(H, r_bot, r_top, wall, base, beta, chamfer, h, z_keys=()):
     """(r, z) profile of an open container: bottom, outer wall, rounded rim, inner wall, inner
     bottom. Wall shape r(u) = r_bot + (r_top − r_bot)·((1−β)u + β√(1−(1−u)²)), z = uH; the inner
-    wall is the outer wall offset by `wall` along its normal. Returns (profile, cavity volume,
-    outer-wall radius function)."""
+    wall is the outer wall offset by `wall` along its normal; the rim is rounded, its crest is the
+    top of the body. Returns (profile, cavity volume, outer-wall radius function, body height);
+    the profile has points at the thirds of the body height."""
     def g(u):
         return (1 - beta) * u + beta * np.sqrt(np.clip(1 - (1 - u) ** 2, 0, None))
 
@@ -635,24 +706,27 @@ def open_profile(H, r_bot, r_top, wall, base, beta, chamfer, h, z_keys=()):
     uu = np.linspace(u_c, 1.0, 4000)
     zi = inner(uu)[:, 1]
     u_b = float(np.interp(base, zi, uu))  # inner wall meets the inner bottom at z = base
-    keys = sorted(set([H / 3, 2 * H / 3, *z_keys]))
+    o1, i1 = outer(np.array([1.0]))[0], inner(np.array([1.0]))[0]
+    top = 0.5 * (o1[1] + i1[1]) + 0.5 * np.linalg.norm(o1 - i1)  # the rounded rim's crest
+    keys = sorted(set([top / 3, 2 * top / 3, *z_keys]))
     pr = Profile()
     p_c = outer(np.array([u_c]))[0]
-    pr.line((0.0, 0.0), (p_c[0] - chamfer, 0.0))
+    # Flat bottoms are single fans: no rings needed for the shape, and every triangle on the table
+    # is a polygon of the hydroelastic contact surface (fewer: faster contact).
+    pr.line((0.0, 0.0), (p_c[0] - chamfer, 0.0), h=1.0)
     pr.line((p_c[0] - chamfer, 0.0), p_c)
     pr.curve(outer, u_c, 1.0, z_keys=[z for z in keys if chamfer < z < H])
-    o1, i1 = outer(np.array([1.0]))[0], inner(np.array([1.0]))[0]
     pr.arc(o1, i1, (0.0, 1.0), n=5)
     pr.curve(inner, 1.0, u_b, z_keys=[z for z in keys if base < z < i1[1]])
     ib = inner(np.array([u_b]))[0]
-    pr.line(ib, (0.0, ib[1]))
+    pr.line(ib, (0.0, ib[1]), h=1.0)
     prof = pr.resampled(h)
     # Cavity (filled to the inner rim): volume of revolution π ∮ r² dz of the inner region.
     cav = np.concatenate([inner(np.linspace(u_b, 1.0, 4000)), [[0.0, i1[1]]], [[0.0, ib[1]]]])
     r0, z0 = cav[:, 0], cav[:, 1]
     r1, z1 = np.roll(r0, -1), np.roll(z0, -1)
     cavity = abs(np.pi * np.sum((z1 - z0) * (r0 ** 2 + r0 * r1 + r1 ** 2) / 3.0))
-    return prof, cavity, (lambda z: r_bot + (r_top - r_bot) * g(np.asarray(z) / H))
+    return prof, cavity, (lambda z: r_bot + (r_top - r_bot) * g(np.asarray(z) / H)), top
 
 
 def offset_closed_profile(prof, t):
@@ -725,13 +799,13 @@ def make_open_container(category, P, variant):
         zh = H - P["hr"] - 0.012
         hp = P["hr"] + 0.003
         z_keys += [zh - hp, zh + hp]
-    prof, cavity, r_of_z = open_profile(H, r_bot, r_top, wall, base, P["beta"], P["chamfer"], h,
-                                        z_keys)
-    lab = lambda pr: thirds_labels(pr[:, 1], H)  # noqa: E731
+    prof, cavity, r_of_z, top = open_profile(H, r_bot, r_top, wall, base, P["beta"],
+                                             P["chamfer"], h, z_keys)
+    lab = lambda pr: thirds_labels(pr[:, 1], top)  # noqa: E731
     idx, qf = body_of_revolution(mb, prof, n, label_fn=lab)
     e_y, e_z = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
     pieces = []
-    dims = {"height": H, "diameter": 2 * r_top, "bottom_diameter": 2 * r_bot, "wall": wall,
+    dims = {"height": top, "diameter": 2 * r_top, "bottom_diameter": 2 * r_bot, "wall": wall,
             "base": base}
     if category == "cup":
         reach = P["reach"]
@@ -778,7 +852,7 @@ def make_open_container(category, P, variant):
     handle_mat = mats.get("handle", variant["material"])
     solids = [(Vp, Fp, handle_mat) for Vp, Fp in pieces] if handle_mat != variant["material"] else []
     return Model(category, V, F, L, variant["material"],
-                 {"handle": handle_mat} if solids else {}, solids, cavity, dims, body_height=H,
+                 {"handle": handle_mat} if solids else {}, solids, cavity, dims, body_height=top,
                  rim={"wall": wall, "opening_radius": r_top - wall})
 
 
@@ -838,13 +912,18 @@ def make_closed_container(category, P, variant):
 
 
 def loft_tool(stations, n_sec, labels):
-    """A tool lofted along +x: stations (x, y_c, z_c, a, b, p, flutes, depth) → closed mesh.
-    The first and last stations are the poles."""
+    """A tool lofted along +x: stations (x, y_c, z_c, a, b, p, flutes, depth[, rc]) → closed mesh.
+    Sections are superellipses (half axes a along y, b along z, exponent p, optional flutes), or
+    rounded rectangles when a corner radius rc > 0 is given. The first and last stations are the
+    poles."""
     mb = MeshBuilder()
-    st = np.asarray(stations, float)
+    st = np.array([tuple(s_) + (0.0,) * (9 - len(s_)) for s_ in stations], float)
     rings = []
-    for x, yc, zc, a, b, p, fl, dep in st[1:-1]:
-        sec = superellipse(n_sec, a, b, p, flutes=int(fl), flute_depth=dep)
+    for x, yc, zc, a, b, p, fl, dep, rc in st[1:-1]:
+        if rc > 0:
+            sec = rounded_rect(n_sec, a, b, min(rc, 0.999 * min(a, b)))
+        else:
+            sec = superellipse(n_sec, a, b, p, flutes=int(fl), flute_depth=dep)
         rings.append(np.column_stack([np.full(n_sec, x), yc + sec[:, 0], zc + sec[:, 1]]))
     rings = np.array(rings)
     idx, _ = loft(mb, rings, labels[1:-1], start=st[0, :3], end=st[-1, :3],
@@ -869,10 +948,10 @@ def make_knife(P, variant):
     st.append((0.0, 0, 0, 0, 0, 2, 0, 0))
     lab.append(HANDLE)
     for x, kk in zip(xs[::-1], k[::-1]):
-        st.append((x, 0, 0, ha * kk, hb * kk, 4.0, 0, 0))
+        st.append((x, 0, 0, ha * kk, hb * kk, 2.0, 0, 0, 0.4 * hb * kk))
         lab.append(HANDLE)
     for x in np.linspace(0.012, Lh, 6):  # flat-sided scales (a rounded-rectangle section)
-        st.append((x, 0, 0, ha, hb, 4.0, 0, 0))
+        st.append((x, 0, 0, ha, hb, 2.0, 0, 0, 0.4 * hb))
         lab.append(HANDLE)
     # bolster: the handle section narrows to the blade's root
     st.append((Lh + 0.006, spine - hblade / 2, 0, hblade / 2, 0.6 * hb, 2.2, 0, 0))
@@ -957,14 +1036,14 @@ def make_spatula(P, variant):
     st, lab = [(0.0, 0, 0, 0, 0, 2, 0, 0)], [HANDLE]
     xs, k = rounded_end(0.008, 0.0, 4)
     for x, kk in zip(xs[::-1], k[::-1]):
-        st.append((x, 0, 0, ha * kk, hb * kk, 4.0, 0, 0))
+        st.append((x, 0, 0, ha * kk, hb * kk, 2.0, 0, 0, 0.7 * hb * kk))
         lab.append(HANDLE)
     for x in np.linspace(0.008, Lh, 5):  # a flat handle, as moulded or riveted ones are
-        st.append((x, 0, 0, ha, hb, 4.0, 0, 0))
+        st.append((x, 0, 0, ha, hb, 2.0, 0, 0, 0.7 * hb))
         lab.append(HANDLE)
     for x, a, b in zip(np.linspace(Lh, Lh + Ln, 4)[1:], (0.8 * ha, 0.55 * ha, 0.45 * ha),
                        (0.7 * hb, 0.5 * hb, 0.4 * hb)):
-        st.append((x, 0, 0, a, max(b, t / 2), 4.0, 0, 0))
+        st.append((x, 0, 0, a, max(b, t / 2), 2.0, 0, 0, 0.7 * max(b, t / 2)))
         lab.append(HANDLE)
     x0 = Lh + Ln
     for s_, w in zip((0.01, 0.02, 0.03), (0.5, 0.8, 1.0)):  # the head widens
@@ -996,7 +1075,7 @@ def make_ladle(P, variant):
     mb = MeshBuilder()
     zh = D - 0.006
     hp = P["lhb"] + 0.002
-    prof, _, r_of_z = open_profile(D, 0.45 * R, R, wall, wall, 0.95, 0.002, 0.008,
+    prof, _, r_of_z, _ = open_profile(D, 0.45 * R, R, wall, wall, 0.95, 0.002, 0.008,
                                    (zh - hp, zh + hp))
     idx, qf = body_of_revolution(mb, prof, 40, label_fn=lambda q: np.full(len(q), USABLE))
     A = patch_on_wall(mb, qf, np.pi, P["lha"] + 0.002, zh - hp, zh + hp)
@@ -1111,10 +1190,10 @@ VARIANTS = {
                dict(material="steel", materials={"handle": "plastic"}),
                dict(material="steel", materials={"handle": "wood"}),
                dict(material="steel", materials={"handle": "wood"})],
-    "knife": [dict(material="steel", materials={"handle": "wood"}),
-              dict(material="steel", materials={"handle": "plastic"}),
-              dict(material="steel", materials={"handle": "plastic"}),
-              dict(material="steel", materials={"handle": "wood"})],
+    "knife": [dict(material="steel", materials={"handle": "wood_tang"}),
+              dict(material="steel", materials={"handle": "plastic_tang"}),
+              dict(material="steel", materials={"handle": "plastic_tang"}),
+              dict(material="steel", materials={"handle": "wood_tang"})],
     "screwdriver": [dict(material="steel", materials={"handle": "plastic"}, tip="flat"),
                     dict(material="steel", materials={"handle": "plastic"}, tip="cross"),
                     dict(material="steel", materials={"handle": "plastic"}, tip="flat"),
@@ -1231,7 +1310,7 @@ def finish(obj_id: str, m: Model) -> dict:
         "com": [rnd(float(c), 6) + 0.0 for c in mp.com],
         "inertia": [rnd(float(x), 9) + 0.0 for x in mp.inertia[np.triu_indices(3)]],
         "extents": [rnd(float(x), 4) for x in hi - lo],
-        "dimensions": {k: rnd(float(v), 4) for k, v in m.dimensions.items()},
+        "dimensions": {k: rnd(v, 6) for k, v in m.dimensions.items()},
         "parts": parts,
         "grasp_widths": {k: rnd(v, 4) for k, v in widths.items()},
         "poses": poses,

@@ -1,0 +1,127 @@
+"""Every library object, put on a table in each pose that suits it, stays put.
+
+Each case builds a MultibodyPlant with the table top of robot_facts.md (a box, compliant
+hydroelastic: modulus 1e7 Pa, resolution hint 0.1 m, Hunt–Crossley dissipation 3 s/m, friction 0.5)
+and the object's SDF (rigid hydroelastic mesh, friction 1.0), places the object at X_WO = X_WT · X_TO
+from library.yaml and simulates 2 s with SAP. The object must not drift or tip, and its contact with
+the table must be a hydroelastic contact surface (not point-pair fallback).
+
+The default run takes one object per category and pose (the first instance); the full sweep of
+all objects × poses is marked slow.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from pydrake.geometry import (
+    AddCompliantHydroelasticProperties,
+    AddContactMaterial,
+    Box,
+    ProximityProperties,
+)
+from pydrake.math import RigidTransform
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlantConfig
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+
+from tg_drake.objects import load_library
+
+TIME_STEP = 0.005  # [s] SAP is implicit: 5 ms holds light cans (10 g) and 2.5 kg pans alike.
+DURATION = 2.0  # [s] of simulated time at rest.
+MAX_DRIFT = 0.005  # [m] displacement of the centre of mass allowed over the 2 s.
+# [rad] 2°: tipping over turns an object by tens of degrees; rocking onto a neighbouring facet
+# of a tessellated round wall turns it by half a facet (4.5° / 2 for 40 segments) at most.
+MAX_TILT = np.radians(2.0)
+X_WT = RigidTransform([0.0, 0.0, 0.75])  # the table top 0.75 m above the floor.
+
+CASES = [(o.id, pose) for o in load_library().values() for pose in o.poses]
+FIRST_OF_CATEGORY = {}
+for _id, _pose in CASES:
+    FIRST_OF_CATEGORY.setdefault((load_library()[_id].category, _pose), (_id, _pose))
+DEFAULT = list(FIRST_OF_CATEGORY.values())
+SLOW = [c for c in CASES if c not in DEFAULT]
+
+
+def rest_on_table(obj_id: str, pose: str) -> dict:
+    """Simulates the object resting on the table; returns what happened."""
+    obj = load_library()[obj_id]
+    t0 = time.perf_counter()
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlant(
+        MultibodyPlantConfig(time_step=TIME_STEP, contact_model="hydroelastic_with_fallback",
+                             discrete_contact_approximation="sap"), builder)
+    table = ProximityProperties()
+    AddCompliantHydroelasticProperties(resolution_hint=0.1, hydroelastic_modulus=1e7,
+                                       properties=table)
+    AddContactMaterial(dissipation=3.0, point_stiffness=None,
+                       friction=CoulombFriction(0.5, 0.5), properties=table)
+    # 1 m × 1 m × 0.1 m slab whose top face is the table-top frame T.
+    plant.RegisterCollisionGeometry(plant.world_body(),
+                                    X_WT @ RigidTransform([0.0, 0.0, -0.05]),
+                                    Box(1.0, 1.0, 0.1), "table", table)
+    Parser(plant).AddModels(str(obj.sdf_path))
+    plant.Finalize()
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
+    body = plant.GetBodyByName(obj_id)
+    X_WO0 = X_WT @ RigidTransform(obj.resting_pose(pose).X_TO)
+    plant.SetFreeBodyPose(context, body, X_WO0)
+    p_OC = np.array(obj.com)
+    t1 = time.perf_counter()
+    simulator.AdvanceTo(DURATION)
+    t2 = time.perf_counter()
+    X_WO = plant.EvalBodyPoseInWorld(context, body)
+    contacts = plant.get_contact_results_output_port().Eval(context)
+    hydro = [contacts.hydroelastic_contact_info(i) for i in
+             range(contacts.num_hydroelastic_contacts())]
+    return {
+        "drift": float(np.linalg.norm(X_WO.multiply(p_OC) - X_WO0.multiply(p_OC))),
+        "tilt": float(X_WO0.rotation().inverse().multiply(X_WO.rotation()).ToAngleAxis().angle()),
+        "n_hydro": len(hydro),
+        "hydro_area": sum(h.contact_surface().total_area() for h in hydro),
+        "hydro_force_z": sum(h.F_Ac_W().translational()[2] for h in hydro),
+        "n_point": contacts.num_point_pair_contacts(),
+        "weight": obj.mass * 9.81,
+        "build_s": t1 - t0,
+        "sim_s": t2 - t1,
+    }
+
+
+def check_rest(obj_id, pose):
+    r = rest_on_table(obj_id, pose)
+    where = f"{obj_id} {pose}: {r}"
+    assert r["drift"] < MAX_DRIFT, where
+    assert r["tilt"] < MAX_TILT, where
+    assert r["n_hydro"] == 1 and r["n_point"] == 0, where
+    assert r["hydro_area"] > 0, where
+    # At rest the hydroelastic surface carries the weight (sign: the force on the first geometry
+    # of the pair, which may be the table or the object): 5 % for the residual rocking.
+    assert abs(abs(r["hydro_force_z"]) - r["weight"]) < 0.05 * r["weight"], where
+
+
+@pytest.mark.parametrize("obj_id,pose", DEFAULT, ids=[f"{i}-{p}" for i, p in DEFAULT])
+def test_rests_on_table(obj_id, pose):
+    check_rest(obj_id, pose)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("obj_id,pose", SLOW, ids=[f"{i}-{p}" for i, p in SLOW])
+def test_rests_on_table_all(obj_id, pose):
+    check_rest(obj_id, pose)
+
+
+if __name__ == "__main__":  # the timings for the report: python tests/integration/test_objects_rest.py
+    total = 0.0
+    for obj_id, pose in CASES:
+        r = rest_on_table(obj_id, pose)
+        total += r["build_s"] + r["sim_s"]
+        print(f"{obj_id:16s} {pose:10s} drift {1000 * r['drift']:6.2f} mm  tilt "
+              f"{np.degrees(r['tilt']):5.2f}°  hydro {r['n_hydro']} point {r['n_point']}  "
+              f"Fz/mg {abs(r['hydro_force_z']) / r['weight']:.3f}  "
+              f"build {r['build_s']:.2f} s  sim {r['sim_s']:.2f} s")
+    print(f"{len(CASES)} cases, {total:.1f} s; default subset {len(DEFAULT)} cases")
