@@ -20,7 +20,7 @@ import numpy as np
 
 from tg_drake.kernels.database import KernelDatabase
 from tg_drake.kernels.evaluation import best, leave_one_object_out
-from tg_drake.kernels.library import SPACING, library_clouds
+from tg_drake.kernels.library import SPACING, library_clouds, library_fingerprint
 from tg_drake.kernels.propagation import BIN_WIDTH, T_MAX, LshProjections, normalise
 
 OUT = Path(__file__).resolve().parents[1] / "tg_drake" / "data" / "kernel_db.npz"
@@ -35,6 +35,7 @@ def build(*, samplings: int, spacing: float, seed: int) -> tuple[KernelDatabase,
     scores = leave_one_object_out(normalise(db.features.kernel()), ids, cats)
     chosen = best(scores)
     db.t_default = chosen.T
+    db.library_fingerprint = library_fingerprint()
     sizes = np.array([len(c.labels) for c in clouds])
     return db, {"n_objects": len(set(ids)), "n_graphs": len(clouds),
                 "points_min": int(sizes.min()), "points_median": float(np.median(sizes)),

@@ -261,6 +261,14 @@ def markdown(result: dict) -> str:
         f"{result['shipped_database_queries']} objects.",
         "",
     ]
+    if "speed" in result:
+        lines += ["## Speed against GraKeL (same graphs, same kernel values)", "",
+                  "| figure | ours | GraKeL | speed-up | reference |", "|---|---|---|---|---|"]
+        for name, f in result["speed"].items():
+            lines.append(f"| `{name}` | {f['median']:.3g} {f['unit']} | "
+                         f"{f['reference_median']:.3g} {f['unit']} | {f['speedup']:.0f}× | "
+                         f"{f['reference']} |")
+        lines.append("")
     return "\n".join(lines)
 
 
@@ -269,6 +277,9 @@ def main(argv=None) -> int:
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
     parser.add_argument("--samplings", type=int, default=3, help="clouds per object")
     parser.add_argument("--spacing", type=float, default=SPACING, help="voxel size [m]")
+    parser.add_argument("--bench", action="store_true",
+                        help="also run the speed figures kernel_query_ms and kernel_loo_s "
+                             "(as `tg-drake bench --only ...`) and add them")
     parser.add_argument("--no-perceived", action="store_true",
                         help="skip the perceived (S_REAL analogue) evaluation")
     parser.add_argument("--out", type=Path, default=RESULTS / "kernel_prior.json",
@@ -309,6 +320,13 @@ def main(argv=None) -> int:
         "shipped_database": shipped_query_times(n_timed),
         "shipped_database_queries": n_timed,
     }
+    if args.bench:
+        from dataclasses import asdict
+
+        from tg_drake.kernels import bench
+
+        result["speed"] = {"kernel_query_ms": asdict(bench.kernel_query_ms()),
+                           "kernel_loo_s": asdict(bench.kernel_loo_s())}
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(result, indent=2) + "\n")
     args.out.with_suffix(".md").write_text(markdown(result))

@@ -49,6 +49,7 @@ class KernelDatabase:
     spacing: float  # [m] voxel size clouds are resampled to before their graph is built.
     k: int = K_NEIGHBOURS  # neighbours per node in the k-nn graph.
     t_default: int = 0  # T used when a query gives none.
+    library_fingerprint: str = ""  # of the object library the graphs were sampled from.
 
     def __post_init__(self):
         self._self_kernels = self.features.self_kernels()
@@ -142,6 +143,7 @@ class KernelDatabase:
             proj_v=self.projections.v, proj_b=self.projections.b,
             w=np.array(self.projections.w), spacing=np.array(self.spacing),
             k=np.array(self.k), t_default=np.array(self.t_default),
+            library_fingerprint=np.array(self.library_fingerprint),
             vocab_sizes=np.array([len(v) for v in f.vocabularies], dtype=np.int64),
             vocab=np.concatenate(f.vocabularies),
             # Per bin (column): how many graphs have it; then those graphs and their counts.
@@ -189,7 +191,9 @@ class KernelDatabase:
                 projections=LshProjections(v=data["proj_v"], b=data["proj_b"],
                                            w=float(data["w"])),
                 spacing=float(data["spacing"]), k=int(data["k"]),
-                t_default=int(data["t_default"]))
+                t_default=int(data["t_default"]),
+                library_fingerprint=str(data["library_fingerprint"])
+                if "library_fingerprint" in data else "")
 
 
 @functools.lru_cache(maxsize=4)

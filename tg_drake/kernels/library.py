@@ -10,6 +10,8 @@ in where the points fall, so they are different graphs of the same shape.
 
 from __future__ import annotations
 
+import hashlib
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -47,3 +49,17 @@ def library_clouds(*, n_samplings: int, spacing: float = SPACING, rng: np.random
             ids.append(obj.id)
             cats.append(CATEGORIES.index(obj.category))
     return clouds, ids, cats
+
+
+def library_fingerprint() -> str:
+    """SHA-256 of what the database depends on: every object's id, category, mesh and part
+    labels, in library order. A database whose fingerprint differs is stale."""
+    from tg_drake.objects import load_library, mesh
+
+    digest = hashlib.sha256()
+    for obj in load_library().values():
+        V, F, L = mesh(obj)
+        digest.update(f"{obj.id}:{obj.category}:{V.shape}:{F.shape};".encode())
+        for a in (V, F, L):
+            digest.update(np.ascontiguousarray(a).tobytes())
+    return digest.hexdigest()
