@@ -26,6 +26,7 @@ class SegmentationConfig:
     cluster_eps: float = 0.012  # DBSCAN neighbourhood radius [m].
     cluster_min_points: int = 4  # DBSCAN core-point neighbour count (voxels).
     min_cluster_points: int = 40  # smaller clusters are noise (voxels).
+    merge_max_gap: float = 0.025  # clusters touching in the image this close in depth merge [m].
     border_margin_px: int = 2  # a cluster with a pixel this close to the image edge is cut [px].
     drop_border_objects: bool = True  # drop objects cut by the image border (else keep them).
     seed: int = 0  # RANSAC random seed.
@@ -62,7 +63,8 @@ class PoseConfig:
 class PartConfig:
     """Semantic parts (paper III-B)."""
 
-    tool_max_thickness: float = 0.045  # a lying object thinner than this across is a tool [m].
+    tool_max_thickness: float = 0.045  # a tool's cross-section is thinner than this ... [m]
+    tool_thin_fraction: float = 0.4  # ... over at least this share of its length.
     top_fraction: float = 1.0 / 3.0  # share of the axis length labelled top.
     bottom_fraction: float = 1.0 / 3.0  # share of the axis length labelled bottom.
     profile_bins: int = 30  # bins along the axis for the tool's cross-section profile.

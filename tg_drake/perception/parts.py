@@ -2,8 +2,9 @@
 
 Two kinds of object, as in the paper:
 
-- **Tools**: the symmetry axis is parallel to the table and the cross-section is thin (its
-  smaller side below `tool_max_thickness`). A tool has a *handle* and a *usable area*. We split
+- **Tools**: the symmetry axis is parallel to the table and the cross-section is thin (both its
+  sides below `tool_max_thickness`) over a good part of the length (`tool_thin_fraction`): the
+  handle of a hammer or a ladle, all of a knife; a bottle lying down is thin only at its neck. A tool has a *handle* and a *usable area*. We split
   the axis where the cross-section changes most: the two-segment piecewise-constant fit of the
   cross-section's width and height along the axis with the least squared error. The usable area
   is the flatter segment (a hammer's head, a knife's blade, a spatula's blade: their cross-section
@@ -114,11 +115,14 @@ def segment_parts(c: Completion, top_sign: float, cfg: PartConfig | None = None)
     q = (c.p_T - c.p_TA) @ R_TO  # points in O's axes, origin on the axis.
     lo, hi = q.min(axis=0), q.max(axis=0)
     extents = hi - lo
-    is_tool = (not c.vertical) and min(extents[0], extents[1]) < cfg.tool_max_thickness
+    is_tool = False
+    if not c.vertical:
+        edges, occupied, profile = _tool_profile(q, cfg.profile_bins)
+        thin = profile.max(axis=1) < cfg.tool_max_thickness
+        is_tool = len(occupied) > 0 and thin.mean() >= cfg.tool_thin_fraction
     labels = np.empty(len(q), int)
     probabilities: dict[str, float] = {}
     if is_tool:
-        edges, occupied, profile = _tool_profile(q, cfg.profile_bins)
         if len(occupied) >= 2:
             k, explained = _best_split(profile)
         else:

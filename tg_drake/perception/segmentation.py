@@ -4,9 +4,10 @@ The table is the largest horizontal plane found by RANSAC (Open3D `segment_plane
 least squares on its inliers. The table frame T has its origin at the inliers' centroid on the
 plane, z along the plane normal (towards the camera, i.e. up) and x along the inliers' principal
 direction. Object points are the points above the plane, inside the table's extent; they are
-averaged per voxel and clustered with DBSCAN (Open3D `cluster_dbscan`). A cluster with a pixel on
-the image border is cut: by default it is dropped, since no completion can recover what the
-image does not hold.
+averaged per voxel and clustered with DBSCAN (Open3D `cluster_dbscan`). Two clusters that touch
+in the image with a short depth step between them are one object whose connection the nearer
+part hides: a pan's handle whose root hides behind the rim. A cluster with a pixel on the image border is cut: by
+default it is dropped, since no completion can recover what the image does not hold.
 """
 
 from __future__ import annotations
@@ -92,6 +93,39 @@ def find_table(p_W: np.ndarray, p_WC: np.ndarray, cfg: SegmentationConfig
         f"{cfg.min_table_fraction:.0%} of the {len(p_W)} points (planes tried, tilt: {tried})")
 
 
+def _merge_occluded(labels_px: np.ndarray, p_px: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+                    image_size: tuple[int, int], n: int, max_gap: float) -> np.ndarray:
+    """Cluster id → merged cluster id, joining clusters that touch in the image (within 2 px)
+    with at most `max_gap` [m] between their points there: one occludes the other's connection
+    to it (a pan's handle whose root hides behind the rim)."""
+    width, height = image_size
+    image = np.full((height + 2, width + 4), -1)
+    image[rows, cols + 2] = labels_px
+    points = np.zeros((height + 2, width + 4, 3))
+    points[rows, cols + 2] = p_px
+    pairs = []
+    for dr, dc in ((0, 1), (0, 2), (1, -2), (1, -1), (1, 0), (1, 1), (1, 2), (2, 0)):
+        a = image[:height, 2:width + 2]
+        b = image[dr:dr + height, 2 + dc:2 + dc + width]
+        m = (a >= 0) & (b >= 0) & (a != b)
+        if m.any():
+            gap = np.linalg.norm(points[:height, 2:width + 2][m]
+                                 - points[dr:dr + height, 2 + dc:2 + dc + width][m], axis=1)
+            close = gap <= max_gap
+            pairs.append(np.column_stack([a[m][close], b[m][close]]))
+    parent = np.arange(n)
+    for i, j in np.unique(np.concatenate(pairs), axis=0) if pairs else []:
+        ri, rj = i, j
+        while parent[ri] != ri:
+            ri = parent[ri]
+        while parent[rj] != rj:
+            rj = parent[rj]
+        parent[max(ri, rj)] = min(ri, rj)
+    for i in range(n):  # flatten (parents have smaller ids)
+        parent[i] = parent[parent[i]]
+    return parent
+
+
 def segment_cloud(p_W: np.ndarray, pixels: np.ndarray, image_size: tuple[int, int],
                   p_WC: np.ndarray, cfg: SegmentationConfig | None = None) -> Segmentation:
     """Table and object clusters of a world-frame cloud whose points came from image pixels.
@@ -144,12 +178,20 @@ def segment_cloud(p_W: np.ndarray, pixels: np.ndarray, image_size: tuple[int, in
         voxel_cut = np.bincount(voxel, weights=border, minlength=len(q)) > 0
         labels = np.asarray(o3d.geometry.PointCloud(o3d.utility.Vector3dVector(q)).cluster_dbscan(
             cfg.cluster_eps, cfg.cluster_min_points))
-        sizes = np.bincount(labels[labels >= 0]) if (labels >= 0).any() else np.zeros(0, int)
-        big = np.flatnonzero(sizes >= cfg.min_cluster_points)
+        n_clusters = int(labels.max()) + 1
+        if n_clusters > 1:
+            keep_px = labels[voxel] >= 0
+            merged = _merge_occluded(labels[voxel][keep_px], p_T[keep_px], r[keep_px],
+                                     c[keep_px], image_size, n_clusters, cfg.merge_max_gap)
+            labels = np.where(labels >= 0, merged[labels], -1)
+        order = np.argsort(labels, kind="stable")
+        bounds = np.searchsorted(labels[order], np.arange(n_clusters + 1))
+        clusters = [order[bounds[k]:bounds[k + 1]] for k in range(n_clusters)]
+        clusters = [c for c in clusters if len(c) >= cfg.min_cluster_points]
         # Deterministic order: by the cluster's centroid x, then y, in the table frame.
-        centroids = np.array([q[labels == k].mean(axis=0) for k in big]).reshape(-1, 3)
-        for k in big[np.lexsort((centroids[:, 1], centroids[:, 0]))]:
-            members = labels == k
+        centroids = np.array([q[c].mean(axis=0) for c in clusters]).reshape(-1, 3)
+        for k in np.lexsort((centroids[:, 1], centroids[:, 0])):
+            members = clusters[k]
             is_cut = bool(voxel_cut[members].any())
             if is_cut and cfg.drop_border_objects:
                 n_dropped += 1
