@@ -206,7 +206,8 @@ def _mesh(obj_id: str):
         raise ModelError(f"cannot read {obj_id}'s mesh: {e}", file=str(o.directory)) from None
     lines = text.splitlines()
     V = np.array([ln.split()[1:4] for ln in lines if ln.startswith("v ")], float)
-    F = np.array([ln.split()[1:4] for ln in lines if ln.startswith("f ")], np.int64) - 1
+    F = np.array([[t.split("/")[0] for t in ln.split()[1:4]] for ln in lines if ln.startswith("f ")],
+                 np.int64) - 1
     if len(labels) != len(V) or F.min() < 0 or F.max() >= len(V):
         raise ModelError(f"{obj_id}: {len(V)} vertices, {len(labels)} part labels, face indices "
                          f"{F.min()}..{F.max()}", file=str(o.mesh_path))

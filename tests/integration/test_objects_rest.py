@@ -12,7 +12,9 @@ all objects × poses is marked slow.
 
 from __future__ import annotations
 
+import importlib.resources
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,13 +22,21 @@ from pydrake.geometry import (
     AddCompliantHydroelasticProperties,
     AddContactMaterial,
     Box,
+    ClippingRange,
+    ColorRenderCamera,
+    DepthRange,
+    DepthRenderCamera,
+    MakeRenderEngineVtk,
     ProximityProperties,
+    RenderCameraCore,
+    RenderEngineVtkParams,
 )
-from pydrake.math import RigidTransform
+from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlantConfig
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.sensors import CameraInfo, RgbdSensor
 
 from tg_drake.objects import load_library
 
@@ -113,6 +123,75 @@ def test_rests_on_table(obj_id, pose):
 @pytest.mark.parametrize("obj_id,pose", SLOW, ids=[f"{i}-{p}" for i, p in SLOW])
 def test_rests_on_table_all(obj_id, pose):
     check_rest(obj_id, pose)
+
+
+def test_resting_transforms_use_drakes_roll_pitch_yaw():
+    for obj in load_library().values():
+        for rest in obj.poses.values():
+            X = RigidTransform(RollPitchYaw(rest.rpy), rest.xyz).GetAsMatrix4()
+            np.testing.assert_allclose(rest.X_TO, X, atol=1e-12)
+
+
+def test_every_sdf_loads_by_package_url_with_its_mass_and_rigid_hydroelastic_mesh():
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(time_step=TIME_STEP), builder)
+    parser = Parser(plant)
+    parser.package_map().AddPackageXml(
+        str(Path(str(importlib.resources.files("tg_drake_models"))) / "package.xml"))
+    for obj in load_library().values():
+        parser.AddModelsFromUrl(obj.sdf_url)
+    plant.Finalize()
+    inspector = scene_graph.model_inspector()
+    for obj in load_library().values():
+        body = plant.GetBodyByName(obj.id)
+        assert body.default_mass() == pytest.approx(obj.mass, rel=1e-5)
+        M = body.default_spatial_inertia()
+        np.testing.assert_allclose(M.get_com(), obj.com, atol=1e-6)  # 1 µm: SDF text precision
+        I_Bcm = M.CalcRotationalInertia().ShiftToCenterOfMass(M.get_mass(), M.get_com())
+        np.testing.assert_allclose(I_Bcm.CopyToFullMatrix3(), obj.inertia,
+                                   atol=1e-9 + 1e-5 * np.abs(obj.inertia).max())
+        (gid,) = plant.GetCollisionGeometriesForBody(body)
+        props = inspector.GetProximityProperties(gid)
+        # rigid hydroelastic: a compliance type without a modulus (HydroelasticType is unbound)
+        assert props.HasProperty("hydroelastic", "compliance_type")
+        assert not props.HasProperty("hydroelastic", "hydroelastic_modulus")
+        friction = props.GetProperty("material", "coulomb_friction")
+        assert (friction.static_friction(), friction.dynamic_friction()) == (1.0, 1.0)
+
+
+def test_objects_render_in_colour_depth_and_labels():
+    """All objects on a grid, seen from above by one RgbdSensor (RenderEngineVtk): each object
+    shows up in the label image and at the right depth."""
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlant(MultibodyPlantConfig(time_step=0.0), builder)
+    scene_graph.AddRenderer("vtk", MakeRenderEngineVtk(RenderEngineVtkParams()))
+    objs = list(load_library().values())
+    cols = 8
+    for k, obj in enumerate(objs):
+        Parser(plant).AddModels(str(obj.sdf_path))
+        xy = [0.45 * (k % cols - (cols - 1) / 2), 0.45 * (k // cols - 2.5)]
+        rest = obj.resting_pose(next(iter(obj.poses)))
+        plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(obj.id),
+                         RigidTransform([*xy, 0.0]) @ RigidTransform(rest.X_TO))
+    plant.Finalize()
+    core = RenderCameraCore("vtk", CameraInfo(800, 600, np.radians(70)), ClippingRange(0.1, 10.0),
+                            RigidTransform())
+    X_WC = RigidTransform(RotationMatrix.MakeXRotation(np.pi), [0.0, 0.0, 3.0])  # looking down
+    camera = builder.AddSystem(RgbdSensor(plant.GetBodyFrameIdOrThrow(plant.world_body().index()),
+                                          X_WC, ColorRenderCamera(core),
+                                          DepthRenderCamera(core, DepthRange(0.1, 10.0))))
+    builder.Connect(scene_graph.get_query_output_port(), camera.query_object_input_port())
+    diagram = builder.Build()
+    context = camera.GetMyContextFromRoot(diagram.CreateDefaultContext())
+    labels = camera.label_image_output_port().Eval(context).data[..., 0]
+    depth = camera.depth_image_32F_output_port().Eval(context).data[..., 0]
+    for obj in objs:
+        mask = labels == int(plant.GetBodyByName(obj.id).index())
+        assert mask.sum() > 20, obj.id  # a few tens of pixels at least, even for a knife
+        # the top of the object is at most its height above the floor plane z = 0: 3 m away
+        top = max(rest.X_TO[2, 3] + np.abs(rest.X_TO[2, :3]) @ np.array(obj.extents)
+                  for rest in obj.poses.values())
+        assert 3.0 - top - 1e-3 <= depth[mask].min() <= 3.0 + 1e-3, obj.id
 
 
 if __name__ == "__main__":  # the timings for the report: python tests/integration/test_objects_rest.py
