@@ -45,6 +45,7 @@ from tg_drake.types import CATEGORIES, PART_LABELS, POSES
 HELP = "list the object library (id, category, size, mass, parts)"
 
 PACKAGE = "tg_drake_models"
+WATER_DENSITY = 1000.0  # [kg/m³]
 
 
 @dataclass(frozen=True)
@@ -99,6 +100,11 @@ class LibraryObject:
     @property
     def is_container(self) -> bool:
         return self.cavity_volume is not None
+
+    @property
+    def water_mass(self) -> float:
+        """[kg] of water that fills the cavity ("full" containment); 0 for other objects."""
+        return WATER_DENSITY * (self.cavity_volume or 0.0)
 
     @property
     def directory(self) -> Path:

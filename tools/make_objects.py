@@ -20,8 +20,13 @@ Each mesh is checked to be a closed, consistently oriented two-manifold with pos
 properties are exact volume integrals of the closed mesh (signed tetrahedra), per material: a
 sub-solid of another material (a wooden handle, an air-filled cavity) is integrated separately and
 its share moved from the body's density to its own. The resting transforms come from the convex hull:
-for each pose, the hull face whose outward normal is closest to the pose's "down" direction and whose
-support polygon contains the centre of mass's projection.
+for each pose, the object is put down on the hull face whose outward normal is closest to the pose's
+"down" direction; from there it tips over any edge of its support polygon its centre of mass
+projects beyond, and rolls over an edge it is within ROLL_MARGIN of when that lowers the centre of
+mass (a mug on its side rolls until its handle touches, as it does in Drake).
+
+Meshes are written with per-corner shading normals (Drake's renderer requires them; smooth across
+edges under 40°, sharp at rims and bottoms) and 1 µm vertex resolution.
 
 Object frame O: containers — origin at the centre of the bottom, z along the symmetry axis towards the
 opening (or neck), handles towards +x. Tools — x along the long axis from the handle to the usable area,
@@ -49,7 +54,6 @@ from scipy.spatial import ConvexHull
 OUT = Path(__file__).resolve().parents[1] / "models" / "objects"
 SEED = 20130706  # the library's one seed; every instance derives its own stream from it.
 N_PER_CATEGORY = 4
-PACKAGE = "tg_drake_models"
 
 # Kept identical to tg_drake.types (the tool runs without importing the package).
 CATEGORIES = ("pan", "pot", "cup", "glass", "bowl", "bottle", "can",
@@ -205,7 +209,7 @@ def _angles(P, c, axis):
     return np.mod(np.arctan2(d @ w, d @ u), 2 * np.pi)
 
 
-def band(mb: MeshBuilder, A: np.ndarray, B: np.ndarray, axis: np.ndarray, label=None):
+def band(mb: MeshBuilder, A: np.ndarray, B: np.ndarray, axis: np.ndarray):
     """Triangles between loops A and B (both anticlockwise about `axis`, B further along it),
     zipped by angle about the axis. Uses A's edges forwards and B's backwards."""
     V = mb.V
@@ -447,7 +451,7 @@ def tube(mb, curve, e_a, half_a, half_b, label, *, n_sec=16, h=0.008, p=2.0, sta
     return idx, rings, end
 
 
-def closed_tube_solid(rings, start=True, end_pole=None):
+def closed_tube_solid(rings, end_pole=None):
     """A closed mesh (V, F) of tube rings capped by planar fans (for a handle's own mass)."""
     mb = MeshBuilder()
     s = rings[0].mean(0)
@@ -658,7 +662,6 @@ class Model:
     pieces: list  # (V, F, material) sub-solids with their own material (cavities: "air")
     cavity_volume: float | None
     dimensions: dict
-    body_height: float | None = None  # containers: height of the body (for the thirds)
     rim: dict = field(default_factory=dict)
 
 
@@ -852,7 +855,7 @@ def make_open_container(category, P, variant):
     handle_mat = mats.get("handle", variant["material"])
     solids = [(Vp, Fp, handle_mat) for Vp, Fp in pieces] if handle_mat != variant["material"] else []
     return Model(category, V, F, L, variant["material"],
-                 {"handle": handle_mat} if solids else {}, solids, cavity, dims, body_height=top,
+                 {"handle": handle_mat} if solids else {}, solids, cavity, dims,
                  rim={"wall": wall, "opening_radius": r_top - wall})
 
 
@@ -907,8 +910,7 @@ def make_closed_container(category, P, variant):
     loft(cmb, rings, 0, start=s, end=e)
     Vc, Fc, _ = cmb.result()
     cavity = volume_integrals(Vc, Fc)[0]
-    return Model(category, V, F, L, variant["material"], {}, [(Vc, Fc, "air")], cavity, dims,
-                 body_height=H)
+    return Model(category, V, F, L, variant["material"], {}, [(Vc, Fc, "air")], cavity, dims)
 
 
 def loft_tool(stations, n_sec, labels):
@@ -1156,7 +1158,7 @@ RANGES = {
     "bottle": dict(R=(0.030, 0.042), H=(0.20, 0.30), rn=(0.0125, 0.016), neck=(0.05, 0.08),
                    shoulder=(0.03, 0.06), punt=(0.002, 0.012), lip=(0.0015, 0.003)),
     "can": dict(R=(0.0265, 0.037), H=(0.10, 0.135)),
-    "hammer": dict(Lh=(0.24, 0.32), Lhead=(0.09, 0.12), rhead=(0.011, 0.015), ha=(0.013, 0.016),
+    "hammer": dict(Lh=(0.24, 0.32), Lhead=(0.09, 0.12), rhead=(0.012, 0.016), ha=(0.013, 0.016),
                    hb=(0.009, 0.011), p=(3.0, 4.0), peen=(0.6, 0.85)),
     "knife": dict(Lh=(0.09, 0.12), Lb=(0.08, 0.20), ha=(0.010, 0.012), hb=(0.0065, 0.008),
                   blade_h=(0.018, 0.045), blade_t=(0.0015, 0.0022)),
