@@ -107,8 +107,11 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
         from tg_drake.systems.perception_system import GroundTruthPerception
 
         perception = builder.AddNamedSystem("perception", GroundTruthPerception(
-            objects=[(p.id, placement_pose(scenario, p).GetAsMatrix4(), p.containment)
-                     for p in scenario.objects]))
+            [p.id for p in scenario.objects],
+            [placement_pose(scenario, p) for p in scenario.objects],
+            X_WT=scenario.X_WT.GetDeterministicValue(),
+            poses=[p.pose for p in scenario.objects],
+            containments=[p.containment for p in scenario.objects]))
     target = builder.AddNamedSystem("target", TargetSelector(X_WO_target.translation()))
     builder.Connect(perception.GetOutputPort("scene_description"), target.get_input_port())
     scene = target.get_output_port()

@@ -246,8 +246,8 @@ def _write_images(folder: Path, station, context, pipeline, camera) -> None:
         plt.imsave(folder / "camera.png", np.array(rgb.data[:, :, :3]))
     scene = pipeline.ports["scene_description"].Eval(
         pipeline.target.GetMyContextFromRoot(context))
-    from tg_drake.perception.plots import save_part_cloud_png
-    save_part_cloud_png(scene, folder / "parts.png")
+    from tg_drake.perception.plot import save_scene_png
+    save_scene_png(scene.objects, folder / "parts.png")
 
 
 def summary(result: dict) -> str:

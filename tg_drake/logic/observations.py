@@ -196,9 +196,11 @@ class Observations:
     @classmethod
     def from_object(cls, obj: ObjectDescription, *,
                     prior: CategoryDistribution | None = None, task: str | None = None,
-                    collisions: tuple[str, ...] = ()) -> Observations:
+                    collisions: tuple[str, ...] = (), prior_floor: float = 0.0
+                    ) -> Observations:
         """From perception's description of one object, the kernel prior (None: uniform), the
-        task ("" or None: infer it) and the parts the planner could not reach."""
+        task ("" or None: infer it) and the parts the planner could not reach. `prior_floor`
+        mixes the prior with the uniform one: (1 − floor)·p + floor/11."""
         category_prior = None
         if prior is not None:
             p = np.asarray(prior.probabilities, dtype=float)
@@ -206,6 +208,10 @@ class Observations:
                 raise RuleError(f"a category prior has {len(CATEGORIES)} entries, one per "
                                 f"category ({', '.join(CATEGORIES)}); got shape {p.shape}",
                                 field="category_prior")
+            if not 0.0 <= prior_floor <= 1.0:
+                raise RuleError(f"prior_floor must lie in [0, 1], got {prior_floor}",
+                                field="prior_floor")
+            p = (1.0 - prior_floor) * p + prior_floor / len(CATEGORIES)
             category_prior = dict(zip(CATEGORIES, p.tolist()))
         return cls(parts=dict(obj.part_probabilities), pose=dict(obj.pose_likelihood),
                    containment=None if obj.containment is None else {obj.containment: 1.0},

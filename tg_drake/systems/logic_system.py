@@ -104,6 +104,7 @@ class LogicQuerySystem(LeafSystem):
             raise RuleError(f"collisions must be a tuple of part names, got {collisions!r}",
                             field="collisions")
         obs = Observations.from_object(scene.objects[target], prior=prior, task=task,
-                                       collisions=tuple(collisions))
+                                       collisions=tuple(collisions),
+                                       prior_floor=self._config.prior_floor)
         answer = self._engine.query(obs, explain=self._config.explain)
         output.set_value(answer.to_semantics(target=target))
