@@ -14,6 +14,7 @@ from tg_drake.grasping.hypotheses import (
     box_grasps,
     clears_plane,
     perturb_grasps,
+    retreat_above_plane,
     surface_grasps,
 )
 
@@ -118,3 +119,21 @@ def test_clears_plane_against_the_wsg_boxes():
     X[:3, :3] = np.column_stack([[0, 1, 0], [1, 0, 0], [0, 0, -1]])
     X[2, 3] = 0.025 + 0.003 + 1e-6
     assert clears_plane(X, 0.0, approach_distance=0.05)[0]
+
+
+def test_retreat_lifts_grasps_on_flat_objects_just_above_the_table():
+    top = np.eye(4)
+    top[:3, :3] = np.column_stack([[1, 0, 0], [0, 0, -1], [0, 1, 0]])  # approach −z_W
+    top[2, 3] = 0.096 - 0.02  # fingertips 2 cm under the table top
+    side = np.eye(4)
+    side[:3, :3] = np.column_stack([[0, 1, 0], [1, 0, 0], [0, 0, -1]])  # approach +x_W
+    side[2, 3] = 0.01  # body bottom under the table: moving back along x does not help
+    tilted = top.copy()
+    tilted[2, 3] = 0.096 - 0.06  # 6 cm under: more than max_retreat
+    X, ok = retreat_above_plane(np.stack([top, side, tilted]), 0.0, approach_distance=0.05,
+                                clearance=0.003, max_retreat=0.05)
+    np.testing.assert_array_equal(ok, [True, False, False])
+    # Moved back 2.3 cm along −y_G = +z_W: fingertips 3 mm above the table.
+    np.testing.assert_allclose(X[0, :3, 3], top[:3, 3] + [0, 0, 0.023], atol=1e-12)
+    np.testing.assert_array_equal(X[1:], np.stack([side, tilted]))  # the others unchanged
+    assert clears_plane(X[0], 0.0, approach_distance=0.05, clearance=0.003 - 1e-9)[0]

@@ -299,3 +299,27 @@ class GraspWorld:
             return "object flew off"
         return None
 
+
+_WORLDS: dict[tuple[str, str], GraspWorld] = {}  # per worker process: the last object's world
+
+
+def run_grasp_batch(payload: dict) -> list[dict]:
+    """Executes a batch of grasps on one object (a job of tools/collect_grasps.py).
+
+    `payload`: {"object_sdf", "object", "pose", "X_WO" (16 floats), "config" (EpisodeConfig
+    fields), "grasps": [{"index", "kind", "part", "X_WG" (16 floats)}, ...]}. Returns one record per
+    grasp: the grasp's fields and the episode's result. The world of the last object is kept for
+    the next batch of this worker process.
+    """
+    config = EpisodeConfig(**payload.get("config", {}))
+    key = (payload["object_sdf"], repr(config))
+    if key not in _WORLDS:
+        _WORLDS.clear()
+        _WORLDS[key] = GraspWorld(payload["object_sdf"], config)
+    world = _WORLDS[key]
+    X_WO = np.array(payload["X_WO"], dtype=float).reshape(4, 4)
+    records = []
+    for grasp in payload["grasps"]:
+        result = world.run(X_WO, np.array(grasp["X_WG"], dtype=float).reshape(4, 4))
+        records.append({"object": payload["object"], "pose": payload["pose"], **grasp, **result})
+    return records

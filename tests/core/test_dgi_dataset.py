@@ -1,0 +1,59 @@
+"""The DGI training set: grasps per library scene and their features."""
+
+import numpy as np
+import pytest
+
+from tg_drake.grasping.dataset import (
+    KINDS,
+    SamplingConfig,
+    scene_cloud,
+    scene_grasps,
+    training_set,
+)
+from tg_drake.grasping.dgi import PAD_CENTER_Y, DgiConfig, dgi_features
+from tg_drake.grasping.hypotheses import clears_plane
+from tg_drake.objects import get_object
+from tg_drake.types import PART_LABELS
+
+
+@pytest.fixture(scope="module")
+def cup():
+    return get_object("cup_01")
+
+
+def test_scene_grasps_are_reproducible_and_clear_the_table(cup):
+    a = scene_grasps(cup, "upright", seed=0)
+    b = scene_grasps(cup, "upright", seed=0)
+    c = scene_grasps(cup, "upright", seed=1)
+    np.testing.assert_array_equal(a.X_WG, b.X_WG)
+    assert a.X_WG.shape != c.X_WG.shape or not np.allclose(a.X_WG, c.X_WG)
+    cfg = SamplingConfig()
+    # 1e-9 m below the clearance: a retreated grasp sits exactly at it, up to rounding.
+    assert clears_plane(a.X_WG, 0.0, approach_distance=cfg.approach_distance,
+                        clearance=cfg.table_clearance - 1e-9).all()
+    assert set(a.kinds) == set(KINDS)
+    assert np.sum(a.kinds == "random") == cfg.n_random
+    # The cup has four parts, each with 12 box hypotheses before the table check.
+    assert np.sum(a.kinds == "box") + a.n_through_table >= 4 * 12
+    assert set(a.parts) <= set(range(len(PART_LABELS)))
+    # Box grasps aim at the object: their grasp points lie within the cup's bounding box.
+    gp = a.X_WG[:, :3, 3] + PAD_CENTER_Y * a.X_WG[:, :3, 1]
+    lo = np.array([-0.04, -0.05, -0.001])  # cup_01 is 10.9 × 8.4 × 9.9 cm, handle along +x
+    hi = np.array([0.07, 0.05, 0.10])
+    box = gp[a.kinds == "box"]
+    assert np.all((box > lo) & (box < hi))
+
+
+def test_training_set_computes_features_of_ok_records_only(cup):
+    scene = scene_grasps(cup, "sideways", seed=0)
+    records = [{"object": "cup_01", "pose": "sideways", "kind": str(k), "part": int(p),
+                "X_WG": X.ravel().tolist(), "status": "ok", "success": bool(i % 2)}
+               for i, (X, k, p) in enumerate(zip(scene.X_WG[:6], scene.kinds, scene.parts))]
+    records.append({"object": "cup_01", "pose": "sideways", "status": "sim_error",
+                    "reason": "object fell through the table during close"})
+    data = training_set(records, seed=0)
+    assert data.X.shape == (6, DgiConfig().n_features)
+    np.testing.assert_array_equal(data.y, [0, 1, 0, 1, 0, 1])
+    p_W, _, _ = scene_cloud(cup, "sideways", seed=0)
+    np.testing.assert_array_equal(data.X, dgi_features(p_W, scene.X_WG[:6]))
+    assert set(data.scenes) == {"cup_01/sideways"}
