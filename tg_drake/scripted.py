@@ -23,7 +23,7 @@ from tg_drake.planning.ik import make_arm_plant, solve_ik
 from tg_drake.scenario import IIWA_HOME, Scenario
 from tg_drake.station import add_station, rotation_from_axes
 
-GRASP_DEPTH = 0.055  # [m] the grasp point lies this far along +y_G from the WSG body origin.
+from tg_drake.planning.planner import GRASP_DEPTH  # noqa: E402  [m] grasp point along +y_G
 
 
 @dataclass

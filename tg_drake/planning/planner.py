@@ -49,6 +49,7 @@ from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.trajectory import (SegmentConfig, SegmentLimits, StraightLine,
                                           plan_segment, shifted)
+from tg_drake.perception.pregrasp import WSG_GRASP_POINT_G
 from tg_drake.scenario import IIWA_HOME, Scenario
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, SceneDescription
 
@@ -80,6 +81,11 @@ class PlannerConfig:
         (0.0, 0.2, 0.0, -1.0, 0.0, 1.6, 0.0),  # from above
     )  # [rad] IK seeds; each is also tried with joint 1 turned towards the target.
     max_candidates_per_part: int = 12  # candidates examined per part before giving up on it.
+    # A side grasp (approach within 30° of horizontal) is also tried tilted downwards about the
+    # closing axis through its grasp point by these angles [deg]: the fingers still close across
+    # the same part, and the wrist rises clear of the table (horizontal grasps low on an object
+    # are out of the iiwa's reach at the table's distance).
+    approach_tilts: tuple = (10.0, 20.0, 35.0)
     free_limits: SegmentLimits = field(default_factory=SegmentLimits)  # moving to the pre-grasp
     contact_limits: SegmentLimits = field(default_factory=lambda: SegmentLimits(
         velocity_scale=0.25, min_duration=1.0))  # straight moves at the object
@@ -227,33 +233,37 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         tried[part] += 1
         part_reachable.setdefault(part, False)
         part_pickable.setdefault(part, False)
-        X_WG = np.asarray(candidates.X_WG[i], float)
-        width = _part_width(target, part, X_WG)
-        if width > config.open_width - config.width_margin:
-            costs[i], reasons[i] = np.inf, (f"{part} is {width:.3f} m across the fingers; the "
-                                            f"WSG opens {config.open_width} m")
-            continue
-        key = _key_poses(arms, X_WG, X_WO, X_WO_place, config)
-        below = [n for n in ("pre-grasp", "grasp") if key.X[n].translation()[2] < table_z]
-        if below:  # the WSG body's origin under the table top: no need to ask the IK
-            costs[i], reasons[i] = np.inf, f"{below[0]} pose puts the gripper under the table"
-            continue
-        poses, failure = _waypoint_configurations(arms, key, seeds, config)
-        if "pre-grasp" in poses:
-            part_reachable[part] = True
-        if failure:
-            # Failing on a place pose, the pick poses were reachable (their motions untried).
-            part_pickable[part] |= PICK_POSES <= set(poses)
-            costs[i], reasons[i] = np.inf, failure
-            continue
-        plan, failure, picked = _trajectories(arms, q_start, poses, key, config, seeds,
-                                              candidate=int(i), part=part)
-        part_pickable[part] |= picked
-        if plan is None:
-            costs[i], reasons[i] = np.inf, failure
-            continue
-        costs[i] = -np.log(score[i])
-        break
+        found = False
+        for X_WG in approach_variants(np.asarray(candidates.X_WG[i], float), config):
+            width = _part_width(target, part, X_WG)
+            if width > config.open_width - config.width_margin:
+                costs[i], reasons[i] = np.inf, (f"{part} is {width:.3f} m across the fingers; "
+                                                f"the WSG opens {config.open_width} m")
+                continue
+            key = _key_poses(arms, X_WG, X_WO, X_WO_place, config)
+            below = [n for n in ("pre-grasp", "grasp") if key.X[n].translation()[2] < table_z]
+            if below:  # the WSG body's origin under the table top: no need to ask the IK
+                costs[i], reasons[i] = np.inf, f"{below[0]} pose puts the gripper under the table"
+                continue
+            poses, failure = _waypoint_configurations(arms, key, seeds, config)
+            if "pre-grasp" in poses:
+                part_reachable[part] = True
+            if failure:
+                # Failing on a place pose, the pick poses were reachable (motions untried).
+                part_pickable[part] |= PICK_POSES <= set(poses)
+                costs[i], reasons[i] = np.inf, failure
+                continue
+            plan, failure, picked = _trajectories(arms, q_start, poses, key, config, seeds,
+                                                  candidate=int(i), part=part)
+            part_pickable[part] |= picked
+            if plan is None:
+                costs[i], reasons[i] = np.inf, failure
+                continue
+            costs[i] = -np.log(score[i])
+            found = True
+            break
+        if found:
+            break
 
     elapsed = time.perf_counter() - t_start
     unreachable = tuple(p for p in parts_order if p in part_pickable and not part_pickable[p])
@@ -271,6 +281,30 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                           unreachable, reason, elapsed)
     return PlanResult("planned", plan, costs, tuple(reasons), part_reachable, unreachable, "",
                       elapsed, plan.candidate, plan.part)
+
+
+def approach_variants(X_WG: np.ndarray, config: PlannerConfig) -> list[np.ndarray]:
+    """X_WG itself, then, for a side grasp, X_WG tilted downwards about its closing axis x_G
+    through the grasp point (GRASP_DEPTH along +y_G) by each of `config.approach_tilts`."""
+    variants = [X_WG]
+    y = X_WG[:3, 1]
+    if abs(y[2]) > np.sin(np.deg2rad(30.0)):
+        return variants
+    p_grasp = X_WG[:3, 3] + GRASP_DEPTH * y
+    for tilt in np.deg2rad(config.approach_tilts):
+        for sign in (1.0, -1.0):
+            c, s_ = np.cos(sign * tilt), np.sin(sign * tilt)
+            R = X_WG[:3, :3] @ np.array([[1, 0, 0], [0, c, -s_], [0, s_, c]])
+            if R[2, 1] < y[2]:  # the approach points further down: this is the tilt we want
+                X = np.eye(4)
+                X[:3, :3] = R
+                X[:3, 3] = p_grasp - GRASP_DEPTH * R[:, 1]
+                variants.append(X)
+                break
+    return variants
+
+
+GRASP_DEPTH = float(WSG_GRASP_POINT_G[1])  # [m] the grasp point lies this far along +y_G.
 
 
 # The key poses and motions of the pick; failures after them are the place's.
