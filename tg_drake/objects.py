@@ -1,4 +1,4 @@
-"""The object library: 44 generated household objects of the paper's 11 categories.
+"""The object library: generated household objects of the paper's 11 categories, four or more each.
 
 Files live in the `tg_drake_models` package (``models/objects/<id>/``): ``<id>.obj`` (the visual and
 collision mesh: closed, outward-oriented triangles), ``<id>.sdf`` (one model and one body with
