@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tg_drake.kernels.database import load_database
-from tg_drake.kernels.library import SPACING, sample_object
+from tg_drake.kernels.library import SPACING, library_fingerprint, sample_object
 from tg_drake.kernels.propagation import BIN_WIDTH
 from tg_drake.objects import load_library
 from tg_drake.types import CATEGORIES
@@ -25,6 +25,12 @@ def test_shipped_database_matches_the_library_and_the_paper_parameters(database)
     assert (database.k, database.projections.w, database.spacing) == (4, BIN_WIDTH, SPACING)
     assert database.t_max == 15 and 0 <= database.t_default <= 15
     assert load_database() is database  # loaded once per process.
+
+
+def test_shipped_database_is_built_from_the_current_library(database):
+    assert database.library_fingerprint == library_fingerprint(), (
+        "tg_drake/data/kernel_db.npz was built from another version of the object library; "
+        "rebuild it with `python tools/build_kernel_db.py`")
 
 
 @pytest.mark.parametrize("obj_id", ["cup_02", "hammer_03", "bottle_01"])
