@@ -234,7 +234,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         part_reachable.setdefault(part, False)
         part_pickable.setdefault(part, False)
         found = False
-        for X_WG in approach_variants(np.asarray(candidates.X_WG[i], float), config):
+        for X_WG in approach_variants(np.asarray(candidates.X_WG[i], float), config,
+                                      table_z=table_z):
             width = _part_width(target, part, X_WG)
             if width > config.open_width - config.width_margin:
                 costs[i], reasons[i] = np.inf, (f"{part} is {width:.3f} m across the fingers; "
@@ -283,13 +284,40 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                       elapsed, plan.candidate, plan.part)
 
 
-def approach_variants(X_WG: np.ndarray, config: PlannerConfig) -> list[np.ndarray]:
+# The open finger pads in G (tools/make_robot_models.py: pads 0.012 × 0.082 × 0.02 m centred
+# 0.055 m along +y_G, inner faces at x = ±0.055 when open): the 8 corners of the pair [m].
+PAD_CORNERS_G = np.array([[sx * x, y, sz * 0.01] for sx in (-1, 1) for x in (0.067,)
+                          for y in (0.014, 0.096) for sz in (-1, 1)])
+TABLE_CLEARANCE = 0.004  # [m] the open pads' lowest corner above the table top
+
+
+def clear_of_table(X_WG: np.ndarray, table_z: float) -> np.ndarray | None:
+    """X_WG moved back along its approach until the open pads clear the table top by
+    TABLE_CLEARANCE (a flat object's top-down grasp point can put the fingertips under the
+    table; the object still lies between the pads' lower parts). None if moving back cannot help
+    (an approach that does not point down)."""
+    p_W = X_WG[:3, :3] @ PAD_CORNERS_G.T + X_WG[:3, 3:4]
+    deficit = table_z + TABLE_CLEARANCE - p_W[2].min()
+    if deficit <= 0:
+        return X_WG
+    down = -X_WG[2, 1]  # how much the approach +y_G points down
+    if down < 0.2:
+        return None
+    X = X_WG.copy()
+    X[:3, 3] -= X_WG[:3, 1] * (deficit / down)
+    return X
+
+
+def approach_variants(X_WG: np.ndarray, config: PlannerConfig, *, table_z: float = 0.0
+                      ) -> list[np.ndarray]:
     """X_WG itself, then, for a side grasp, X_WG tilted downwards about its closing axis x_G
-    through the grasp point (GRASP_DEPTH along +y_G) by each of `config.approach_tilts`."""
+    through the grasp point (GRASP_DEPTH along +y_G) by each of `config.approach_tilts`; each
+    moved back along its approach when its open pads would reach under the table
+    (`clear_of_table`), and dropped when that cannot help."""
     variants = [X_WG]
     y = X_WG[:3, 1]
     if abs(y[2]) > np.sin(np.deg2rad(30.0)):
-        return variants
+        return [X for X in map(lambda V: clear_of_table(V, table_z), variants) if X is not None]
     p_grasp = X_WG[:3, 3] + GRASP_DEPTH * y
     for tilt in np.deg2rad(config.approach_tilts):
         for sign in (1.0, -1.0):
@@ -301,7 +329,7 @@ def approach_variants(X_WG: np.ndarray, config: PlannerConfig) -> list[np.ndarra
                 X[:3, 3] = p_grasp - GRASP_DEPTH * R[:, 1]
                 variants.append(X)
                 break
-    return variants
+    return [X for X in map(lambda V: clear_of_table(V, table_z), variants) if X is not None]
 
 
 GRASP_DEPTH = float(WSG_GRASP_POINT_G[1])  # [m] the grasp point lies this far along +y_G.

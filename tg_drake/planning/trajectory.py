@@ -117,7 +117,59 @@ def plan_segment(arm: ArmPlant, q0, q1, *, min_distance: float, limits: SegmentL
             segment.solve_time = time.perf_counter() - t_start
             return segment
         reason = segment.reason
-    return Segment(False, None, np.inf, -np.inf, reason, time.perf_counter() - t_start)
+    # The optimiser can stop at its iteration limit on short moves that a plain interpolation
+    # does well: accept the smooth joint-space interpolation when it passes every check.
+    segment = interpolated_segment(arm, q0, q1, min_distance=min_distance, limits=limits,
+                                   config=config, line=line)
+    if segment.success:
+        segment.solve_time = time.perf_counter() - t_start
+        return segment
+    return Segment(False, None, np.inf, -np.inf, f"{reason}; {segment.reason}",
+                   time.perf_counter() - t_start)
+
+
+# The quintic rest-to-rest profile s(τ) = 10τ³ − 15τ⁴ + 6τ⁵ (zero velocity and acceleration at
+# both ends): its peak speed is 15/8 and its peak acceleration 10/√3 (for a unit move in unit time).
+QUINTIC_PEAK_SPEED = 15.0 / 8.0
+QUINTIC_PEAK_ACCELERATION = 10.0 / np.sqrt(3.0)
+
+
+def interpolated_segment(arm: ArmPlant, q0, q1, *, min_distance: float,
+                         limits: SegmentLimits, config: SegmentConfig,
+                         line: StraightLine | None = None) -> Segment:
+    """The straight joint-space move q0 → q1 on the quintic rest-to-rest profile, timed for the
+    velocity and acceleration limits, if it passes the dense clearance check and (for a straight
+    move) keeps the gripper within the line and angle tolerances; else a failed Segment."""
+    q0, q1 = np.asarray(q0, float), np.asarray(q1, float)
+    delta = np.abs(q1 - q0)
+    v = np.asarray(limits.velocity) * limits.velocity_scale
+    a = np.asarray(limits.acceleration)
+    duration = float(np.clip(max(np.max(QUINTIC_PEAK_SPEED * delta / v),
+                                 np.sqrt(np.max(QUINTIC_PEAK_ACCELERATION * delta / a))),
+                             limits.min_duration, limits.max_duration))
+    # A degree-5 Bézier with its end points tripled is exactly the quintic profile.
+    basis = BsplineBasis(6, 6, initial_parameter_value=0.0, final_parameter_value=duration)
+    path = BsplineTrajectory(basis, [q.reshape(-1, 1) for q in (q0, q0, q0, q1, q1, q1)])
+    ts = check_times(path, config.check_step)
+    d = np.array([clearance(arm, path.value(t)[:, 0]) for t in ts])
+    if d.min() < config.check_fraction * min_distance:
+        return Segment(False, None, np.inf, float(d.min()),
+                       f"the interpolated move comes within {d.min():.4f} m of a collision")
+    if line is not None:
+        p0, p1 = np.asarray(line.p_W0, float), np.asarray(line.p_W1, float)
+        u = (p1 - p0) / max(np.linalg.norm(p1 - p0), 1e-9)
+        R_ref = line.R_WG.matrix()
+        for t in ts:
+            arm.plant.SetPositions(arm.plant_context, arm.full_q(path.value(t)[:, 0]))
+            X = arm.G.CalcPoseInWorld(arm.plant_context)
+            r = X.translation() - p0
+            off_line = np.linalg.norm(r - np.dot(r, u) * u)
+            angle = np.arccos(np.clip((np.trace(R_ref.T @ X.rotation().matrix()) - 1) / 2, -1, 1))
+            if off_line > config.line_tolerance or angle > config.angle_tolerance:
+                return Segment(False, None, np.inf, float(d.min()),
+                               f"the interpolated move leaves the straight line by "
+                               f"{off_line * 1000:.0f} mm / {np.rad2deg(angle):.1f}°")
+    return Segment(True, path, duration, float(d.min()))
 
 
 def _solve_with_refinement(arm, q0, q1, guess_knots, *, min_distance, limits, config, line
