@@ -234,8 +234,11 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         part_reachable.setdefault(part, False)
         part_pickable.setdefault(part, False)
         found = False
-        for X_WG in approach_variants(np.asarray(candidates.X_WG[i], float), config,
-                                      table_z=table_z):
+        variants = approach_variants(np.asarray(candidates.X_WG[i], float), config,
+                                     table_z=table_z)
+        if not variants:
+            costs[i], reasons[i] = np.inf, "the open pads would reach under the table top"
+        for X_WG in variants:
             width = _part_width(target, part, X_WG)
             if width > config.open_width - config.width_margin:
                 costs[i], reasons[i] = np.inf, (f"{part} is {width:.3f} m across the fingers; "
