@@ -83,6 +83,7 @@ class LibraryObject:
     mass: float  # [kg]
     volume: float  # [m³] volume of material (a closed bottle's or can's cavity excluded).
     cavity_volume: float | None  # [m³] containers: water volume when "full"; None otherwise.
+    cavity_centroid: tuple[float, float, float] | None  # [m] in O: centroid of that water (upright).
     com: tuple[float, float, float]  # [m] centre of mass in O.
     inertia: np.ndarray  # (3, 3) [kg·m²] about the centre of mass, O's axes.
     extents: tuple[float, float, float]  # [m] bounding-box side lengths along O's x, y, z.
@@ -156,7 +157,9 @@ def _object(obj_id: str, d: dict) -> LibraryObject:
     return LibraryObject(
         id=obj_id, category=d["category"], material=d["material"], density=d["density"],
         part_materials=MappingProxyType(dict(d["part_materials"])), mass=d["mass"],
-        volume=d["volume"], cavity_volume=d["cavity_volume"], com=tuple(d["com"]),
+        volume=d["volume"], cavity_volume=d["cavity_volume"],
+        cavity_centroid=None if d["cavity_centroid"] is None else tuple(d["cavity_centroid"]),
+        com=tuple(d["com"]),
         inertia=inertia, extents=tuple(d["extents"]),
         dimensions=MappingProxyType(dict(d["dimensions"])),
         parts=tuple(p for p in PART_LABELS if p in d["parts"]),

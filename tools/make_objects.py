@@ -660,7 +660,7 @@ class Model:
     material: str  # main material (the body; for tools, the usable area's)
     part_materials: dict  # part name → material, where it differs from `material`
     pieces: list  # (V, F, material) sub-solids with their own material (cavities: "air")
-    cavity_volume: float | None
+    cavity: tuple | None  # containers: (volume [m³], height of its centroid [m]) filled to the rim
     dimensions: dict
     rim: dict = field(default_factory=dict)
 
@@ -687,7 +687,8 @@ def open_profile(H, r_bot, r_top, wall, base, beta, chamfer, h, z_keys=()):
     bottom. Wall shape r(u) = r_bot + (r_top − r_bot)·((1−β)u + β√(1−(1−u)²)), z = uH; the inner
     wall is the outer wall offset by `wall` along its normal; the rim is rounded, its crest is the
     top of the body. Returns (profile, cavity volume, outer-wall radius function, body height);
-    the profile has points at the thirds of the body height."""
+    the profile has points at the thirds of the body height. The cavity is (volume, height of its
+    centroid)."""
     def g(u):
         return (1 - beta) * u + beta * np.sqrt(np.clip(1 - (1 - u) ** 2, 0, None))
 
@@ -728,7 +729,9 @@ def open_profile(H, r_bot, r_top, wall, base, beta, chamfer, h, z_keys=()):
     cav = np.concatenate([inner(np.linspace(u_b, 1.0, 4000)), [[0.0, i1[1]]], [[0.0, ib[1]]]])
     r0, z0 = cav[:, 0], cav[:, 1]
     r1, z1 = np.roll(r0, -1), np.roll(z0, -1)
-    cavity = abs(np.pi * np.sum((z1 - z0) * (r0 ** 2 + r0 * r1 + r1 ** 2) / 3.0))
+    vol = np.pi * np.sum((z1 - z0) * (r0 ** 2 + r0 * r1 + r1 ** 2) / 3.0)
+    mz = np.pi * np.sum((z1 - z0) * ((r0 + r1) / 2) ** 2 * (z0 + z1) / 2)  # midpoint rule, 4000 pts
+    cavity = (abs(vol), mz / vol)
     return prof, cavity, (lambda z: r_bot + (r_top - r_bot) * g(np.asarray(z) / H)), top
 
 
@@ -909,7 +912,8 @@ def make_closed_container(category, P, variant):
     rings, s, e = revolve(cav, n)
     loft(cmb, rings, 0, start=s, end=e)
     Vc, Fc, _ = cmb.result()
-    cavity = volume_integrals(Vc, Fc)[0]
+    vol, first, _ = volume_integrals(Vc, Fc)
+    cavity = (vol, first[2] / vol)
     return Model(category, V, F, L, variant["material"], {}, [(Vc, Fc, "air")], cavity, dims)
 
 
@@ -1313,7 +1317,8 @@ def finish(obj_id: str, m: Model) -> dict:
         "part_materials": dict(sorted(m.part_materials.items())),
         "mass": sig(mp.mass),
         "volume": sig(mp.volume),
-        "cavity_volume": None if m.cavity_volume is None else sig(m.cavity_volume),
+        "cavity_volume": None if m.cavity is None else sig(m.cavity[0]),
+        "cavity_centroid": None if m.cavity is None else [0.0, 0.0, rnd(m.cavity[1], 6)],
         "com": [rnd(c, 6) for c in mp.com],
         "inertia": [sig(x) for x in mp.inertia[np.triu_indices(3)]],
         "extents": [rnd(float(x), 4) for x in hi - lo],
@@ -1437,7 +1442,8 @@ def generate(out: Path, verbose=False) -> dict:
               "# Units: metres, kilograms, kg/m³, kg·m². Object frame O: containers — origin at the\n"
               "# bottom centre, z along the symmetry axis towards the opening, handles towards +x;\n"
               "# tools — x along the long axis towards the usable area, z up when lying flat, origin at\n"
-              "# the bottom centre of the bounding box. poses: X_TO (table-top frame T → object frame\n"
+              "# the bottom centre of the bounding box. cavity_volume, cavity_centroid: the water of a\n"
+              "# 'full' container (filled to the rim, upright). poses: X_TO (table-top frame T → object frame\n"
               "# O) as xyz + rpy (Drake's RollPitchYaw) resting on z = 0; support_margin: how far the\n"
               "# centre of mass projects inside the support polygon. inertia: ixx ixy ixz iyy iyz izz\n"
               "# about the centre of mass. grasp_widths: smallest width of each part across the\n"

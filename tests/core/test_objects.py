@@ -156,6 +156,9 @@ def test_mass_and_inertia_are_plausible(obj_id):
         # weight in water (the heaviest, a steel or cast-iron pan, about 0.6)
         assert obj.is_container and obj.water_mass == pytest.approx(1000.0 * obj.cavity_volume)
         assert obj.water_mass > 0.5 * obj.mass
+        # the water's centroid is on the axis, inside the body, above the base
+        x, y, z = obj.cavity_centroid
+        assert (x, y) == (0.0, 0.0) and obj.dimensions.get("base", 0.0) < z < obj.dimensions["height"]
 
 
 @pytest.mark.parametrize("obj_id", IDS)
