@@ -39,6 +39,8 @@ import numpy as np
 from tg_drake.errors import PerceptionError
 from tg_drake.perception.config import CompletionConfig
 
+# Circle tests whose confidences differ by less than this are equally sure.
+CONFIDENCE_TIE = 0.05
 # The top region is a ridge along a lying object's axis when its principal variance is this many
 # times its secondary one (a strip at least twice as long as wide).
 RIDGE_EIGEN_RATIO = 4.0
@@ -116,7 +118,8 @@ def circle_test(q: np.ndarray, cfg: CompletionConfig) -> CircleFit:
     outside = occupied & (outline > (1 + cfg.circle_tolerance) * radius)
     run = _largest_cyclic_run(outside)
     is_handle = (run.any() and run.sum() <= cfg.max_handle_fraction * n_bins
-                 and outline[run].max() >= (1 + cfg.handle_min_protrusion) * radius)
+                 and outline[run].max() >= max((1 + cfg.handle_min_protrusion) * radius,
+                                               radius + cfg.handle_min_reach))
     handle_bins = run if is_handle else np.zeros(n_bins, bool)
     rest = occupied & ~handle_bins
     on_circle = rest & (np.abs(outline - radius) <= cfg.circle_tolerance * radius)
@@ -184,15 +187,15 @@ def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = No
     candidates = [_vertical_candidate(W, top, c_top, d_z, e1, e2, cfg)]
     candidates += [_horizontal_candidate(W, z, c_top, d_z, d, cfg) for d in directions]
 
-    # Choose: the one candidate whose cross-section is a circle; else the paper's rule (the axis
-    # is the box direction not in the pair of closest dimensions) among the passing candidates,
-    # or among the PCA box's three directions when none passes.
+    # Choose: the candidate whose cross-section is most surely a circle; between candidates as
+    # sure as each other, or when none passes, the paper's rule (the axis is the box direction
+    # not in the pair of closest dimensions).
     passing = [c for c in candidates if c.fit.ok]
+    if passing:
+        best = max(c.fit.confidence for c in passing)
+        passing = [c for c in passing if c.fit.confidence >= best - CONFIDENCE_TIE]
     if len(passing) == 1:
         chosen, margin = passing[0], passing[0].fit.confidence
-    elif passing and not any(c.vertical for c in passing):
-        chosen = max(passing, key=lambda c: c.fit.confidence)
-        margin = chosen.fit.confidence
     else:
         ranked = sorted(passing or candidates[:3], key=lambda c: c.gap)
         chosen = ranked[0]
@@ -203,10 +206,8 @@ def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = No
     p_TA, a = chosen.p_TA, chosen.a
     if fit is None:
         handle_direction = np.zeros(3)
-    else:  # the circle test's plane has axes (b, up) for a horizontal axis, (x, y) for vertical.
-        u, v = ((np.array([1.0, 0, 0]), np.array([0, 1.0, 0])) if chosen.vertical
-                else (np.append(chosen.b, 0.0), np.array([0, 0, 1.0])))
-        handle_direction = fit.handle_direction[0] * u + fit.handle_direction[1] * v
+    else:  # the handle's direction in the circle test's plane, in T.
+        handle_direction = fit.handle_direction[0] * chosen.u + fit.handle_direction[1] * chosen.v
     dims = np.array([2 * np.abs((W - p_TA[:2]) @ e1).max(),
                      2 * np.abs((W - p_TA[:2]) @ e2).max(), d_z])
 
@@ -232,7 +233,8 @@ class _Candidate:
 
     vertical: bool
     a: np.ndarray  # (3,) unit axis direction in T.
-    b: np.ndarray  # (2,) horizontal direction across a horizontal axis (zeros when vertical).
+    u: np.ndarray  # (3,) first axis of the circle test's plane (orthogonal to a).
+    v: np.ndarray  # (3,) second axis of the circle test's plane.
     fit: CircleFit
     p_TA: np.ndarray  # (3,) axis point in T.
     gap: float  # the paper's rule: difference of the two box dimensions across the axis [m].
@@ -256,8 +258,8 @@ def _vertical_candidate(W: np.ndarray, top: np.ndarray, c_top: np.ndarray, d_z: 
                 fit, c = fit2, c2
     body = ~fit.handle if fit.ok else np.ones(len(W), bool)
     gap = abs(2 * np.abs((W[body] - c) @ e1).max() - 2 * np.abs((W[body] - c) @ e2).max())
-    return _Candidate(True, np.array([0.0, 0.0, 1.0]), np.zeros(2), fit,
-                      np.array([c[0], c[1], 0.5 * d_z]), gap)
+    return _Candidate(True, np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]),
+                      np.array([0.0, 1.0, 0.0]), fit, np.array([c[0], c[1], 0.5 * d_z]), gap)
 
 
 def _horizontal_candidate(W: np.ndarray, z: np.ndarray, c_top: np.ndarray, d_z: float,
@@ -283,31 +285,91 @@ def _horizontal_candidate(W: np.ndarray, z: np.ndarray, c_top: np.ndarray, d_z: 
         height = 0.5 * d_z
     p_xy = 0.5 * (s_a.min() + s_a.max()) * a + (c_top @ b) * b
     gap = abs(2 * np.abs(across[~fit.handle] if fit.ok else across).max() - d_z)
-    return _Candidate(False, np.append(a, 0.0), b, fit, np.array([p_xy[0], p_xy[1], height]),
-                      gap)
+    up = np.array([0.0, 0.0, 1.0])
+    candidate = _Candidate(False, np.append(a, 0.0), np.append(b, 0.0), up, fit,
+                           np.array([p_xy[0], p_xy[1], height]), gap)
+    if not fit.ok:
+        tilted = _tilted_candidate(W, z, a, b, c_top, gap, cfg)
+        if tilted is not None and tilted.fit.ok:
+            return tilted
+    return candidate
+
+
+def _robust_circle(q: np.ndarray, tolerance: float) -> tuple[np.ndarray, float] | None:
+    """Least-squares (Kåsa) circle through 2D points, refitted twice without the points off it
+    by more than `tolerance`·R (a handle, an inner wall): (centre, radius), or None."""
+    keep = np.ones(len(q), bool)
+    centre, radius = np.zeros(2), 0.0
+    for _ in range(3):
+        if keep.sum() < 5:
+            return None
+        A = np.column_stack([2 * q[keep], np.ones(keep.sum())])
+        sol, *_ = np.linalg.lstsq(A, (q[keep] ** 2).sum(axis=1), rcond=None)
+        centre = sol[:2]
+        radius = float(np.sqrt(max(sol[2] + centre @ centre, 0.0)))
+        keep = np.abs(np.linalg.norm(q - centre, axis=1) - radius) <= tolerance * radius
+    return (centre, radius) if radius > 0 else None
+
+
+def _tilted_candidate(W: np.ndarray, z: np.ndarray, a: np.ndarray, b: np.ndarray,
+                      c_top: np.ndarray, gap: float, cfg: CompletionConfig
+                      ) -> _Candidate | None:
+    """A lying round body whose axis is tilted from the table (a mug resting on its rim and its
+    handle): circles fitted to the cross-sections of its two halves along a give two axis
+    points; the axis through them is tested like the others. None when it is not a lying axis
+    (tilted by more than 45°)."""
+    s_a = W @ a
+    across = (W - c_top) @ b
+    half = s_a < np.median(s_a)
+    centres = []
+    for m in (half, ~half):
+        fit = _robust_circle(np.column_stack([across[m], z[m]]), 2 * cfg.circle_tolerance)
+        if fit is None:
+            return None
+        centres.append(s_a[m].mean() * np.append(a, 0.0)
+                       + np.append((c_top @ b + fit[0][0]) * b, fit[0][1]))
+    axis = centres[1] - centres[0]
+    if np.linalg.norm(axis) < 1e-6 or abs(axis[2]) > np.linalg.norm(axis) * np.sqrt(0.5):
+        return None
+    axis = axis / np.linalg.norm(axis)
+    p_A = 0.5 * (centres[0] + centres[1])
+    u = np.append(b, 0.0) - (np.append(b, 0.0) @ axis) * axis
+    u = u / np.linalg.norm(u)
+    v = np.cross(axis, u)
+    d = np.column_stack([W, z]) - p_A
+    fit = circle_test(np.column_stack([d @ u, d @ v]), cfg)
+    s = d @ axis
+    p_A = p_A + 0.5 * (s.min() + s.max()) * axis  # the middle of the visible extent
+    return _Candidate(False, axis, u, v, fit, p_A, gap)
 
 
 def _vertical_fit(W: np.ndarray, top: np.ndarray, c: np.ndarray, cfg: CompletionConfig
                   ) -> tuple[CircleFit, np.ndarray]:
-    """Circle test of W about c (the paper's top-region centroid).
+    """Circle test of W about c, then two refinements of c, each kept when it does not lower
+    the test's confidence:
 
-    Once the handle is known, c is recomputed without it. When the test passes, the centre is
-    refined by a least-squares (Kåsa) circle through the outline points on the circle: the
-    top region of a bottle is its neck, whose visible side pulls the centroid towards the
-    camera by a few millimetres, enough to make the body look lopsided.
+    - the top region's centroid without the handle points, once they are known (the paper's
+      estimate, cleaned of a handle at rim height);
+    - the centre of a least-squares (Kåsa) circle through the outline points on the circle: the
+      top region of a bottle is its neck, whose visible side pulls the centroid towards the
+      camera by a few millimetres, enough to make the body look lopsided; the top region of a
+      tilted pan lying upside down is one side of its bottom.
     """
     fit = circle_test(W - c, cfg)
+    keep = top & ~fit.handle
+    if fit.handle.any() and keep.any():
+        c1 = W[keep].mean(axis=0)
+        fit1 = circle_test(W - c1, cfg)
+        if fit1.confidence >= fit.confidence:
+            fit, c = fit1, c1
     for _ in range(2):
-        keep = top & ~fit.handle
-        if not fit.handle.any() or not keep.any():
+        if len(fit.rim) < 3:
             break
-        c = W[keep].mean(axis=0)
-        fit = circle_test(W - c, cfg)
-    if fit.ok and len(fit.rim) >= 3:
         rim = W[fit.rim] - c
         A = np.column_stack([2 * rim, np.ones(len(rim))])
         sol, *_ = np.linalg.lstsq(A, (rim ** 2).sum(axis=1), rcond=None)
         refit = circle_test(W - (c + sol[:2]), cfg)
-        if refit.ok:
-            fit, c = refit, c + sol[:2]
+        if refit.confidence < fit.confidence or (fit.ok and not refit.ok):
+            break
+        fit, c = refit, c + sol[:2]
     return fit, c

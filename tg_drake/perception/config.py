@@ -26,7 +26,7 @@ class SegmentationConfig:
     cluster_eps: float = 0.012  # DBSCAN neighbourhood radius [m].
     cluster_min_points: int = 4  # DBSCAN core-point neighbour count (voxels).
     min_cluster_points: int = 40  # smaller clusters are noise (voxels).
-    merge_max_gap: float = 0.025  # clusters touching in the image this close in depth merge [m].
+    merge_max_gap: float = 0.05  # clusters touching in the image this close in depth merge [m].
     border_margin_px: int = 2  # a cluster with a pixel this close to the image edge is cut [px].
     drop_border_objects: bool = True  # drop objects cut by the image border (else keep them).
     seed: int = 0  # RANSAC random seed.
@@ -42,7 +42,8 @@ class CompletionConfig:
     circle_tolerance: float = 0.08  # outline radius within ±this share of R is on the circle.
     min_circle_fraction: float = 0.85  # share of non-handle outline bins on the circle.
     min_circle_coverage: float = 0.9  # share of folded outline bins that must hold points.
-    handle_min_protrusion: float = 0.2  # a handle reaches at least (1 + this)·R from the axis.
+    handle_min_protrusion: float = 0.1  # a handle reaches at least (1 + this)·R from the axis ...
+    handle_min_reach: float = 0.012  # ... and at least this far beyond the circle [m].
     max_handle_fraction: float = 0.45  # a handle covers at most this share of the folded outline.
     min_handle_points: int = 8  # fewer points outside the circle are noise, not a handle.
 
@@ -55,7 +56,7 @@ class PoseConfig:
     cavity_depth_fraction: float = 0.12  # ... or this share of the object height if larger.
     min_cavity_share: float = 0.25  # share of far-side points inside the rim that are deep.
     min_cavity_points: int = 6  # at least this many deep points make a cavity.
-    neck_ratio: float = 0.6  # top radius below this share of the base radius is a neck.
+    neck_ratio: float = 0.75  # top radius below this share of the base radius is a neck.
     taper_ratio: float = 0.92  # top radius below this share of the base radius is a taper.
 
 
@@ -63,8 +64,10 @@ class PoseConfig:
 class PartConfig:
     """Semantic parts (paper III-B)."""
 
-    tool_max_thickness: float = 0.045  # a tool's cross-section is thinner than this ... [m]
-    tool_thin_fraction: float = 0.4  # ... over at least this share of its length.
+    tool_max_thickness: float = 0.04  # a tool's cross-section is thinner than this ... [m]
+    tool_thin_fraction: float = 0.55  # ... over at least this share of its length.
+    tool_handle_ratio: float = 1.5  # a handle reaching beyond this many body diameters makes
+    # a long-handled tool lying on its head (a ladle), not a pan.
     top_fraction: float = 1.0 / 3.0  # share of the axis length labelled top.
     bottom_fraction: float = 1.0 / 3.0  # share of the axis length labelled bottom.
     profile_bins: int = 30  # bins along the axis for the tool's cross-section profile.

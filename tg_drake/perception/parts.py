@@ -2,9 +2,12 @@
 
 Two kinds of object, as in the paper:
 
-- **Tools**: the symmetry axis is parallel to the table and the cross-section is thin (both its
-  sides below `tool_max_thickness`) over a good part of the length (`tool_thin_fraction`): the
-  handle of a hammer or a ladle, all of a knife; a bottle lying down is thin only at its neck. A tool has a *handle* and a *usable area*. We split
+- **Tools**: the symmetry axis is parallel to the table and the visible cross-section is thin
+  (both its sides below `tool_max_thickness`) over a good part of the length
+  (`tool_thin_fraction`): the handle of a hammer or a ladle, all of a knife; a bottle lying down
+  is thin only at its neck. A round body with a handle longer than `tool_handle_ratio` times its
+  diameter is a long-handled tool lying on its head (a ladle on its bowl): the body is its
+  usable area; the circle test's confidence is both parts' probability. A tool has a *handle* and a *usable area*. We split
   the axis where the cross-section changes most: the two-segment piecewise-constant fit of the
   cross-section's width and height along the axis with the least squared error. The usable area
   is the flatter segment (a hammer's head, a knife's blade, a spatula's blade: their cross-section
@@ -54,14 +57,28 @@ class Parts:
     boxes: dict[str, tuple[np.ndarray, np.ndarray]]  # part → (centre in T, half extents in O).
 
 
-def _object_frame(c: Completion, top_sign: float) -> np.ndarray:
+def _long_handle(c: Completion, cfg: PartConfig) -> bool:
+    """A vertical body with a handle longer than `tool_handle_ratio` body diameters: a ladle
+    lying on its bowl. (A pan's handle is about as long as the pan is wide.)"""
+    if not c.vertical or c.circle is None or not c.handle.any():
+        return False
+    d = c.p_T[c.handle] - c.p_TA
+    reach = np.linalg.norm(d - np.outer(d @ c.axis_T, c.axis_T), axis=1).max() - c.circle.radius
+    return reach > cfg.tool_handle_ratio * 2 * c.circle.radius
+
+
+def _object_frame(c: Completion, top_sign: float, long_handle: bool = False) -> np.ndarray:
+    if long_handle:  # z from the handle to the head (the body), x up.
+        z = -c.handle_direction_T / np.linalg.norm(c.handle_direction_T)
+        x = np.array([0.0, 0.0, 1.0])
+        return np.column_stack([x, np.cross(z, x), z])
     z = top_sign * c.axis_T
     if np.linalg.norm(c.handle_direction_T) > 0:
         x = c.handle_direction_T - (c.handle_direction_T @ z) * z
     elif c.vertical:
         x = c.R_TB[:, 0].copy()
-    else:
-        x = np.array([0.0, 0.0, 1.0])
+    else:  # up, made orthogonal to a tilted axis
+        x = np.array([0.0, 0.0, 1.0]) - z[2] * z
     x = x / np.linalg.norm(x)
     return np.column_stack([x, np.cross(z, x), z])
 
@@ -111,18 +128,27 @@ def _coverage(s_visible: np.ndarray, lo: float, hi: float, bins: int) -> float:
 def segment_parts(c: Completion, top_sign: float, cfg: PartConfig | None = None) -> Parts:
     """Part labels, probabilities, object frame and part boxes of a completed object."""
     cfg = cfg or PartConfig()
-    R_TO = _object_frame(c, top_sign)
+    long_handle = _long_handle(c, cfg)
+    R_TO = _object_frame(c, top_sign, long_handle)
     q = (c.p_T - c.p_TA) @ R_TO  # points in O's axes, origin on the axis.
     lo, hi = q.min(axis=0), q.max(axis=0)
     extents = hi - lo
     is_tool = False
     if not c.vertical:
-        edges, occupied, profile = _tool_profile(q, cfg.profile_bins)
+        # The visible points' profile: a tool lying on the table need not be symmetric about
+        # the axis (a ladle's handle rises from its bowl), and the completion would mirror it.
+        edges, occupied, profile = _tool_profile(q[c.visible], cfg.profile_bins)
         thin = profile.max(axis=1) < cfg.tool_max_thickness
         is_tool = len(occupied) > 0 and thin.mean() >= cfg.tool_thin_fraction
     labels = np.empty(len(q), int)
     probabilities: dict[str, float] = {}
-    if is_tool:
+    if long_handle:
+        is_tool = True
+        labels[:] = USABLE
+        labels[c.handle] = HANDLE
+        p = c.circle.confidence
+        probabilities = {"handle": p, "usable_area": p}
+    elif is_tool:
         if len(occupied) >= 2:
             k, explained = _best_split(profile)
         else:

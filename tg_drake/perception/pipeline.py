@@ -23,7 +23,7 @@ from tg_drake.perception.geometry import (
     voxel_average,
 )
 from tg_drake.perception.parts import segment_parts
-from tg_drake.perception.pose import estimate_pose
+from tg_drake.perception.pose import estimate_pose, tool_pose
 from tg_drake.perception.pregrasp import part_pregrasps
 from tg_drake.perception.segmentation import segment_depth
 from tg_drake.types import ObjectDescription, PartBox, SceneDescription, part_index
@@ -62,6 +62,8 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
     c = complete(p_T, n_T, cfg.completion)
     pose = estimate_pose(c, n_T, p_TC, cfg.pose)
     parts = segment_parts(c, pose.top_sign, cfg.parts)
+    if parts.is_tool:
+        pose = tool_pose(c)
 
     X_WO = X_WT @ make_transform(parts.R_TO, parts.p_TO)
     boxes = {name: PartBox(X_WT @ make_transform(parts.R_TO, centre), half)

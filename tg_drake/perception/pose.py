@@ -10,24 +10,28 @@ direction of the axis gives the pose); its likelihood is the confidence of that 
    only through the opening, so the opening (the top) faces the camera: an upright object when
    the axis is vertical (the camera is above the table), the axis end on the camera's side when
    it is horizontal. This is the cue of an upright cup, glass, bowl, pan or open pot.
-2. **Neck.** With no cavity seen, the top is closed. A top much narrower than the base over a
+2. **Handle.** A handle at one end of the body marks the top: pans and pots carry their
+   handles at the rim (a cup's handle spans the middle of its side and says nothing).
+3. **Neck.** With no cavity seen, the top is closed. A top much narrower than the base over a
    body as wide as the base at mid-height is a neck: an upright bottle.
-3. **Taper.** A closed top narrower than the base otherwise, narrowing steadily from a rim on the
+4. **Taper.** A closed top narrower than the base otherwise, narrowing steadily from a rim on the
    table, is the shape of a tapered open container (glass, cup, bowl) resting on its rim:
    upside-down.
-4. Otherwise (closed and straight, like a can) the object is upright with a weak likelihood:
+5. Otherwise (closed and straight, like a can) the object is upright with a weak likelihood:
    standing upright is the usual pose (the paper's S_GRASP and S_ROBOT scenes use only upright
    and sideways), and an upside-down straight container looks the same from above.
 
-For a horizontal axis without a cavity, the narrower end is the top (the neck of a bottle lying
-down); equal ends keep the axis direction.
+For a horizontal axis without a cavity or a handle at one end, the narrower end is the top (the
+neck of a bottle lying down); equal ends keep the axis direction.
+
+The thresholds of the cues (`PoseConfig`) were chosen on renders of our object library.
 """
 
 from __future__ import annotations
 
-import numpy as np
-
 from dataclasses import dataclass
+
+import numpy as np
 
 from tg_drake.perception.completion import Completion
 from tg_drake.perception.config import PoseConfig
@@ -35,6 +39,7 @@ from tg_drake.types import POSES
 
 # P(upright) given each cue, for a vertical axis (see the module docstring).
 P_UPRIGHT_CAVITY = 0.95
+P_UPRIGHT_HANDLE = 0.85
 P_UPRIGHT_NECK = 0.9
 P_UPRIGHT_TAPER = 0.3
 P_UPRIGHT_STRAIGHT = 0.6
@@ -49,6 +54,8 @@ INWARD_CENTRE_COSINE = 0.3
 RADIUS_QUANTILE = 0.95
 # Each end's slice is this share of the object's length along the axis.
 END_SLICE = 0.15
+# A handle whose centroid lies in this share of the body's length next to one end is at that end.
+HANDLE_END = 0.3
 # Two ends whose radii differ by less than this share are equal.
 EQUAL_ENDS = 0.05
 
@@ -58,7 +65,8 @@ class PoseEstimate:
     pose: str  # the decision: the axis first (vertical or not), then which end is the top.
     likelihood: dict[str, float]  # POSES entry → probability (sums to 1).
     top_sign: float  # +1 when the object's top is at the positive end of the axis, else −1.
-    cue: str  # the cue that placed the top: "cavity", "neck", "taper", "straight" or "ends".
+    cue: str  # the cue that placed the top: "cavity", "handle", "neck", "taper", "straight",
+    # or "ends".
 
 
 def inward_facing(p: np.ndarray, n: np.ndarray, p_A: np.ndarray, a: np.ndarray) -> np.ndarray:
@@ -88,6 +96,27 @@ def _profile_radii(c: Completion) -> tuple[float, float, float]:
                  for m in slices)
 
 
+def _handle_end(c: Completion) -> int:
+    """+1 (−1) when the handle sits at the high (low) end of the body along the axis, else 0."""
+    if not c.handle.any():
+        return 0
+    s_body = (c.p_T[~c.handle] - c.p_TA) @ c.axis_T
+    s_handle = float(np.mean((c.p_T[c.handle] - c.p_TA) @ c.axis_T))
+    lo, hi = s_body.min(), s_body.max()
+    f = (s_handle - lo) / max(hi - lo, 1e-9)
+    return 1 if f > 1.0 - HANDLE_END else (-1 if f < HANDLE_END else 0)
+
+
+def tool_pose(c: Completion) -> PoseEstimate:
+    """A tool lies on the table: sideways, as sure as the axis (or, for a long-handled tool on
+    its head, the circle test) is."""
+    p = c.axis_margin if c.circle is None else max(c.axis_margin, c.circle.confidence)
+    rest = 1.0 - p
+    return PoseEstimate("sideways", {"upright": rest * P_UPRIGHT_STRAIGHT, "sideways": p,
+                                     "upsidedown": rest * (1.0 - P_UPRIGHT_STRAIGHT)}, 1.0,
+                        "tool")
+
+
 def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
                   cfg: PoseConfig | None = None) -> PoseEstimate:
     """Pose of a completed object and its likelihood.
@@ -109,9 +138,12 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
     cavity = (inward.sum() >= cfg.min_cavity_points
               and inward.mean() >= cfg.min_cavity_share)
     r_low, r_mid, r_high = _profile_radii(c)
+    handle_end = _handle_end(c)
     if c.vertical:
         if cavity:
             p_up, cue = P_UPRIGHT_CAVITY, "cavity"
+        elif handle_end != 0:
+            p_up, cue = (P_UPRIGHT_HANDLE if handle_end > 0 else 1 - P_UPRIGHT_HANDLE), "handle"
         elif r_high < cfg.neck_ratio * r_low and r_mid >= cfg.taper_ratio * r_low:
             p_up, cue = P_UPRIGHT_NECK, "neck"
         elif r_high < cfg.taper_ratio * r_low:
@@ -126,6 +158,8 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
         if cavity:
             top_sign = 1.0 if (p_TC - c.p_TA) @ c.axis_T >= 0 else -1.0
             cue = "cavity"
+        elif handle_end != 0:
+            top_sign, cue = float(handle_end), "handle"
         elif abs(r_high - r_low) > EQUAL_ENDS * max(r_high, r_low):
             top_sign = 1.0 if r_high < r_low else -1.0
             cue = "neck"
