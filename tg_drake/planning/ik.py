@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import Box, CollisionFilterDeclaration, GeometrySet
+from pydrake.geometry import Box, Cylinder, CollisionFilterDeclaration, GeometrySet
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.parsing import ModelDirectives, ProcessModelDirectives
@@ -22,6 +22,11 @@ from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 from pydrake.systems.framework import DiagramBuilder
 
 from tg_drake.scenario import IIWA_HOME, Scenario, default_directives
+
+
+# Weight of the IK's pull towards its seed [1/rad²]: a preference among the solutions that meet
+# the (hard) pose and clearance constraints.
+IK_SEED_WEIGHT = 0.01
 
 
 @dataclass
@@ -48,7 +53,8 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
                    finger_opening: float = 0.11, held=None, finger_contact=()) -> ArmPlant:
     """A kinematic model of the arm for IK and collision checking.
 
-    obstacles: iterable of (name, X_WB RigidTransform, (sx, sy, sz)) boxes welded to the world.
+    obstacles: iterable of (name, X_WB RigidTransform, size) welded to the world: a box when size
+        is (sx, sy, sz), a cylinder along z when it is (radius, length).
     held: None, or (X_GO RigidTransform, (sx, sy, sz)): a box carried in the hand, welded to the
         gripper frame G. It never collides with the gripper or links 6–7 (it is in the hand), and
         it does collide with the rest of the arm, the table and the obstacles.
@@ -74,9 +80,11 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
     touchable = []
     for name, X_WB, size in obstacles:
         instance = plant.AddModelInstance(f"obstacle_{name}")
-        body = plant.AddRigidBody(f"obstacle_{name}", instance,
-                                  SpatialInertia.SolidBoxWithMass(1.0, *size))
-        plant.RegisterCollisionGeometry(body, RigidTransform(), Box(*size), f"obstacle_{name}",
+        body = plant.AddRigidBody(f"obstacle_{name}", instance, SpatialInertia.SolidBoxWithMass(
+            1.0, *(size if len(size) == 3 else (2 * size[0], 2 * size[0], size[1]))))
+        # (sx, sy, sz): a box; (radius, length): a cylinder along the obstacle frame's z.
+        shape = Box(*size) if len(size) == 3 else Cylinder(*size)
+        plant.RegisterCollisionGeometry(body, RigidTransform(), shape, f"obstacle_{name}",
                                         CoulombFriction(0.5, 0.5))
         plant.WeldFrames(world.body_frame(), body.body_frame(), X_WB)
         added.append((name, X_WB, size))
@@ -178,7 +186,8 @@ def solve_ik(arm: ArmPlant, X_WG: RigidTransform, *, q_seed=IIWA_HOME,
                 for k in range(7)]
     q_nominal = q_all.copy()
     q_nominal[iiwa_idx] = q_seed if q_guess is None else q_guess
-    prog.AddQuadraticErrorCost(np.eye(len(iiwa_idx)) * 0.01, np.asarray(q_seed), q[iiwa_idx])
+    prog.AddQuadraticErrorCost(np.eye(len(iiwa_idx)) * IK_SEED_WEIGHT, np.asarray(q_seed),
+                               q[iiwa_idx])
     prog.SetInitialGuess(q, q_nominal)
     options = SolverOptions()
     options.SetOption(SnoptSolver().solver_id(), "Major iterations limit", max_iterations)

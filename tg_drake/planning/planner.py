@@ -218,7 +218,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                             release_height=config.release_height)
     boxes = [(f"object{i}", RigidTransform(o.X_WO), tuple(o.extents))
              for i, o in enumerate(obstacles)]
-    target_box = ("target", RigidTransform(X_WO), tuple(target.extents))
+    target_box = target_shapes(target)
     placed_box = ("target_placed", RigidTransform(X_WO_place), tuple(target.extents))
     arms = _Arms(scenario, config.open_width, boxes, target_box, placed_box)
     bearing = float(np.arctan2(X_WO[1, 3], X_WO[0, 3]))
@@ -311,6 +311,37 @@ def clear_of_table(X_WG: np.ndarray, table_z: float) -> np.ndarray | None:
     return X
 
 
+ROUND_RATIO = 0.85  # a part box whose two cross extents agree this well is taken as round
+
+
+def target_shapes(target: ObjectDescription) -> list[tuple]:
+    """Obstacles standing for the object to be grasped (names target_*): one per part box —
+    a cylinder along the object's symmetry axis for a round part of a non-tool (perception's
+    completion makes its top, middle and bottom rotationally symmetric), a box otherwise — or the
+    whole box when perception gave no part boxes. Round parts as cylinders rather than boxes keep
+    the box corners from blocking tilted side grasps that clear the real surface."""
+    X_WO = np.asarray(target.X_WO, float)
+    if not target.part_boxes:
+        return [("target", RigidTransform(X_WO), tuple(target.extents))]
+    shapes = []
+    z_O = X_WO[:3, 2]
+    for name, box in target.part_boxes.items():
+        X_WB = np.asarray(box.X_WB, float)
+        size = 2.0 * np.asarray(box.half_extents, float)
+        along = np.abs(X_WB[:3, :3].T @ z_O)  # which box axis is the symmetry axis
+        k = int(np.argmax(along))
+        cross = np.delete(size, k)
+        if (not target.is_tool and name in ("top", "middle", "bottom") and along[k] > 0.99
+                and cross.min() >= ROUND_RATIO * cross.max()):
+            X = np.eye(4)
+            X[:3, :3] = X_WO[:3, :3]
+            X[:3, 3] = X_WB[:3, 3]
+            shapes.append((f"target_{name}", RigidTransform(X), (cross.max() / 2, size[k])))
+        else:
+            shapes.append((f"target_{name}", RigidTransform(X_WB), tuple(size)))
+    return shapes
+
+
 def approach_variants(X_WG: np.ndarray, config: PlannerConfig, *, table_z: float = 0.0
                       ) -> list[np.ndarray]:
     """X_WG itself, then, for a side grasp, X_WG tilted downwards about its closing axis x_G
@@ -354,10 +385,11 @@ class _Arms:
     placed: the other objects and the target at its place pose, which the finger pads may overlap
     (release, retreat)."""
 
-    def __init__(self, scenario, opening, boxes, target_box, placed_box):
+    def __init__(self, scenario, opening, boxes, target_shapes, placed_box):
         self._scenario, self._opening = scenario, opening
-        self._boxes, self._target, self._placed = list(boxes), target_box, placed_box
+        self._boxes, self._target, self._placed = list(boxes), list(target_shapes), placed_box
         self._cache: dict = {}
+        self._held_size = tuple(placed_box[2])  # the object's box, carried in the hand
 
     def _make(self, key, extra=(), held=None, finger_contact=()) -> ArmPlant:
         if key not in self._cache:
@@ -368,11 +400,11 @@ class _Arms:
 
     @property
     def free(self) -> ArmPlant:
-        return self._make("free", [self._target])
+        return self._make("free", self._target)
 
     @property
     def grasp(self) -> ArmPlant:
-        return self._make("grasp", [self._target], finger_contact=[self._target[0]])
+        return self._make("grasp", self._target, finger_contact=[t[0] for t in self._target])
 
     @property
     def placed(self) -> ArmPlant:
@@ -380,7 +412,7 @@ class _Arms:
 
     def carry(self, X_GO: RigidTransform) -> ArmPlant:
         key = ("carry", tuple(np.round(X_GO.GetAsMatrix4().ravel(), 9)))
-        return self._make(key, held=(X_GO, self._target[2]))
+        return self._make(key, held=(X_GO, self._held_size))
 
 
 def _seeds(q_start, postures, bearing) -> list[np.ndarray]:
