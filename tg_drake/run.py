@@ -107,9 +107,15 @@ def run_scenario(scenario, *, scenario_path: str = "", meshcat=None, images_dir:
             result["category_prior"] = _distribution(prior.distributions[scene.target].as_dict())
             semantics = timed("logic", pipeline.ports["grasp_semantics"])
             result.update(_semantics_json(semantics))
+            result["grasp_probability"] = round(float(semantics.grasp_probability), 6)
             if not semantics.part or max(semantics.part.values()) <= 0:
                 outcome = Outcome("failed", "logic", "the logic ruled every grasp out "
                                   f"(task {scenario.task.task or 'inferred'})")
+            elif semantics.grasp_probability < pipeline.config.min_grasp_probability:
+                outcome = Outcome(
+                    "failed", "logic", "the logic rules grasping out: P(some part is grasped) = "
+                    f"{semantics.grasp_probability:.3f} < {pipeline.config.min_grasp_probability}"
+                    f" (task {scenario.task.task or 'inferred'})")
         if outcome is None:
             ranked = timed("dgi_scoring", pipeline.ports["ranked_grasps"])
             result["n_hypotheses"] = int(len(ranked.score))

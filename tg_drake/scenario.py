@@ -196,6 +196,8 @@ class PipelineConfig:
     use_prior: bool = True  # the kernel prior feeds the logic (PLM); False: uniform (PLM_uniform)
     planning_start: float = 0.05  # [s] simulated time of the first planning event
     max_requeries: int = 3  # re-queries of the logic with collision(Part) evidence
+    min_grasp_probability: float = 0.03  # below this P(some part is grasped | observations), the
+    # logic is taken to rule grasping out (an upside-down pan: 0.015; the paper's Fig. 1 cup: 0.13)
 
     def validate(self, where: str = "pipeline") -> None:
         if self.perception not in PERCEPTION_MODES:

@@ -142,6 +142,9 @@ class GraspSemantics:
     # "category" / "task" / "part" → explanations of the leading answers.
     collisions: tuple[str, ...] = ()  # parts given as collision(Part) evidence.
     target: int = 0  # index of the object in the scene description these answers are about.
+    grasp_probability: float = 1.0  # P(some part is grasped | observations) before `part` was
+    # normalised: near 0 when the constraints rule grasping out in almost every world (e.g. an
+    # upside-down pan with a small chance of being something else).
 
 
 @dataclass

@@ -61,3 +61,24 @@ def test_camera_sees_the_table_at_the_right_depth(station):
     expected_depth = -X_WC.translation()[2] / ray_W[2]
     assert depth[v, u] == pytest.approx(expected_depth, abs=2e-3)  # 2 mm: depth rendering precision
     assert np.isfinite(depth).mean() > 0.5  # the table fills most of the view
+
+
+def test_depth_image_shows_an_object_on_the_table():
+    from tg_drake.objects import get_object
+    from tg_drake.scenario import ObjectPlacement
+
+    empty, _ = make_station(Scenario())
+    with_can, st = make_station(Scenario(objects=[ObjectPlacement(id="can_02", pose="upright")]))
+    depths = [d.GetOutputPort("camera0.depth_image").Eval(d.CreateDefaultContext()).data[:, :, 0]
+              for d in (empty, with_can)]
+    closer = depths[1] < depths[0] - 0.01  # 1 cm: well above depth noise (none in the renderer)
+    # The can (about 6.8 cm wide, 12.3 cm tall at ~0.85 m) covers roughly 50 × 100 pixels.
+    assert 1500 < closer.sum() < 10000
+    # The covered pixels are where the can is: around the image column of the table's centre.
+    rows, cols = np.nonzero(closer)
+    assert abs(cols.mean() - st.cameras["camera0"].info.center_x()) < 20
+    # And their depth matches the can's distance from the camera (within its radius).
+    X_WC = with_can.GetOutputPort("camera0.camera_pose").Eval(with_can.CreateDefaultContext())
+    distance = np.linalg.norm(X_WC.translation() - [0.75, 0.0, 0.06])
+    radius = get_object("can_02").dimensions["diameter"] / 2
+    assert np.median(depths[1][closer]) == pytest.approx(distance, abs=2 * radius)

@@ -99,6 +99,7 @@ class LogicAnswer:
     observed_parts: tuple[str, ...]  # parts with probability > 0.
     collisions: tuple[str, ...] = ()
     explanations: dict[str, list[Explanation]] = field(default_factory=dict)
+    grasp_probability: float = 1.0  # P(exactly one part grasped | e), before normalising `part`.
 
     def distribution(self, query: str) -> dict[str, float]:
         values = getattr(self, query)
@@ -114,7 +115,7 @@ class LogicAnswer:
             category=self.distribution("category"), task=self.distribution("task"),
             part=self.distribution("part"), given_task=self.given_task,
             explanations=dict(self.explanations), collisions=tuple(self.collisions),
-            target=target)
+            target=target, grasp_probability=float(self.grasp_probability))
 
 
 def _normalise(conditional: np.ndarray) -> np.ndarray:
@@ -134,7 +135,7 @@ def _answer(obs: Observations, joints: dict[str, np.ndarray], evidence: float,
         category=_normalise(joints["category"]), task=task, part=_normalise(joints["part"]),
         given_task=obs.task, evidence=float(evidence),
         observed_parts=tuple(p for p in PART_LABELS if obs.parts.get(p, 0.0) > 0.0),
-        collisions=tuple(obs.collisions))
+        collisions=tuple(obs.collisions), grasp_probability=float(joints["part"].sum()))
 
 
 def _inconsistent(obs: Observations, config: TheoryConfig) -> RuleError:
