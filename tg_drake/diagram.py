@@ -121,7 +121,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     builder.Connect(scene, prior.GetInputPort("scene_description"))
     logic = builder.AddNamedSystem("logic", LogicQuerySystem(LogicQueryConfig(
         category=config.category_theory, grasp=config.grasp_theory,
-        use_prior=config.use_prior)))
+        use_prior=config.use_prior, prior_floor=config.prior_floor)))
     task = builder.AddNamedSystem("task", ConstantValueSource(
         AbstractValue.Make(scenario.task.task)))
     builder.Connect(scene, logic.GetInputPort("scene_description"))

@@ -194,6 +194,8 @@ class PipelineConfig:
     category_theory: str = "specific"  # category model variant: specific | general
     grasp_theory: str = "specific"  # grasp model variant: specific | general
     use_prior: bool = True  # the kernel prior feeds the logic (PLM); False: uniform (PLM_uniform)
+    prior_floor: float = 0.02  # the logic sees (1 − floor)·prior + floor/11: a perceived object's
+    # kernel prior can miss its category, and a zero there would make the evidence impossible
     planning_start: float = 0.05  # [s] simulated time of the first planning event
     max_requeries: int = 3  # re-queries of the logic with collision(Part) evidence
     min_grasp_probability: float = 0.03  # below this P(some part is grasped | observations), the

@@ -396,10 +396,11 @@ class LogicQueryConfig:
     grasp: str = "specific"  # task-dependent grasp model variant: "specific" or "general".
     exclusive: bool = True  # mutually exclusive outcomes (the paper) or normalised marginals.
     use_prior: bool = True  # use the kernel's category prior (PLM); False: uniform (PLM_uniform).
-    prior_floor: float = 0.02  # mix the kernel prior with this much of the uniform prior:
+    prior_floor: float = 0.0  # mix the kernel prior with this much of the uniform prior:
     # p = (1 − floor)·p_kernel + floor/11. A retrieval prior from 10 neighbours can miss the true
     # category entirely; without a floor, parts that rule out every category it names make the
-    # observations impossible (probability 0). 0 reproduces the paper's prior exactly.
+    # observations impossible (probability 0). 0 (the default) is the paper's prior exactly; the
+    # pipeline uses PipelineConfig.prior_floor.
     explain: bool = True  # attach explanations (one batched circuit pass more per query).
 
     def theory(self) -> TheoryConfig:
