@@ -39,6 +39,8 @@ import numpy as np
 from tg_drake.errors import PerceptionError
 from tg_drake.perception.config import CompletionConfig
 
+# Normals within acos(0.5) = 60° of an axis estimate are on end faces, not the side wall.
+SIDE_WALL_COSINE = 0.5
 # Circle tests whose confidences differ by less than this are equally sure.
 CONFIDENCE_TIE = 0.05
 # The top region is a ridge along a lying object's axis when its principal variance is this many
@@ -185,7 +187,9 @@ def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = No
         if evals_t[1] > RIDGE_EIGEN_RATIO * max(evals_t[0], 1e-12):
             directions.append(evecs_t[:, 1] * (1.0 if evecs_t[0, 1] >= 0 else -1.0))
     candidates = [_vertical_candidate(W, top, c_top, d_z, e1, e2, cfg)]
-    candidates += [_horizontal_candidate(W, z, c_top, d_z, d, cfg) for d in directions]
+    # A tilted lying axis is tried along W's long direction and the top ridge only.
+    candidates += [_horizontal_candidate(W, z, c_top, d_z, d, cfg, n_T if i != 1 else None)
+                   for i, d in enumerate(directions)]
 
     # Choose: the candidate whose cross-section is most surely a circle; between candidates as
     # sure as each other, or when none passes, the paper's rule (the axis is the box direction
@@ -256,6 +260,8 @@ def _vertical_candidate(W: np.ndarray, top: np.ndarray, c_top: np.ndarray, d_z: 
             fit2, c2 = _vertical_fit(W, top, s1_c * e1 + mid2 * e2, cfg)
             if fit2.confidence > fit.confidence:
                 fit, c = fit2, c2
+    if not fit.ok:  # no circle: the paper's top-region centroid.
+        c = c_top
     body = ~fit.handle if fit.ok else np.ones(len(W), bool)
     gap = abs(2 * np.abs((W[body] - c) @ e1).max() - 2 * np.abs((W[body] - c) @ e2).max())
     return _Candidate(True, np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]),
@@ -263,12 +269,15 @@ def _vertical_candidate(W: np.ndarray, top: np.ndarray, c_top: np.ndarray, d_z: 
 
 
 def _horizontal_candidate(W: np.ndarray, z: np.ndarray, c_top: np.ndarray, d_z: float,
-                          a: np.ndarray, cfg: CompletionConfig) -> _Candidate:
+                          a: np.ndarray, cfg: CompletionConfig, n: np.ndarray | None = None
+                          ) -> _Candidate:
     """A horizontal axis along a through the top region's centroid across it (paper).
 
     Along the axis its point is the middle of the visible extent; its height is d_z / 2 (the
     box centroid) or, when that fits the circle better, the radius of a round body lying on
-    the table: a handle sticking up raises d_z but not the body's axis.
+    the table: a handle sticking up raises d_z but not the body's axis. Given the normals n,
+    an axis found from them, possibly tilted from the table, is tried when the horizontal one
+    fails (`_tilted_candidate`).
     """
     b = np.array([-a[1], a[0]])
     s_a = W @ a
@@ -288,8 +297,8 @@ def _horizontal_candidate(W: np.ndarray, z: np.ndarray, c_top: np.ndarray, d_z: 
     up = np.array([0.0, 0.0, 1.0])
     candidate = _Candidate(False, np.append(a, 0.0), np.append(b, 0.0), up, fit,
                            np.array([p_xy[0], p_xy[1], height]), gap)
-    if not fit.ok:
-        tilted = _tilted_candidate(W, z, a, b, c_top, gap, cfg)
+    if n is not None and not fit.ok:
+        tilted = _tilted_candidate(W, z, n, a, b, gap, cfg)
         if tilted is not None and tilted.fit.ok:
             return tilted
     return candidate
@@ -300,46 +309,66 @@ def _robust_circle(q: np.ndarray, tolerance: float) -> tuple[np.ndarray, float] 
     by more than `tolerance`·R (a handle, an inner wall): (centre, radius), or None."""
     keep = np.ones(len(q), bool)
     centre, radius = np.zeros(2), 0.0
+    x, y = q[:, 0], q[:, 1]
+    r2 = x * x + y * y
     for _ in range(3):
-        if keep.sum() < 5:
+        n = int(keep.sum())
+        if n < 5:
             return None
-        A = np.column_stack([2 * q[keep], np.ones(keep.sum())])
-        sol, *_ = np.linalg.lstsq(A, (q[keep] ** 2).sum(axis=1), rcond=None)
+        xk, yk, rk = x[keep], y[keep], r2[keep]
+        # Normal equations of [2x 2y 1]·(cx, cy, c) = x² + y².
+        sx, sy = xk.sum(), yk.sum()
+        M = np.array([[4 * (xk @ xk), 4 * (xk @ yk), 2 * sx],
+                      [4 * (xk @ yk), 4 * (yk @ yk), 2 * sy],
+                      [2 * sx, 2 * sy, n]])
+        rhs = np.array([2 * (xk @ rk), 2 * (yk @ rk), rk.sum()])
+        try:
+            sol = np.linalg.solve(M, rhs)
+        except np.linalg.LinAlgError:
+            return None
         centre = sol[:2]
         radius = float(np.sqrt(max(sol[2] + centre @ centre, 0.0)))
-        keep = np.abs(np.linalg.norm(q - centre, axis=1) - radius) <= tolerance * radius
+        keep = np.abs(np.hypot(x - centre[0], y - centre[1]) - radius) <= tolerance * radius
     return (centre, radius) if radius > 0 else None
 
 
-def _tilted_candidate(W: np.ndarray, z: np.ndarray, a: np.ndarray, b: np.ndarray,
-                      c_top: np.ndarray, gap: float, cfg: CompletionConfig
-                      ) -> _Candidate | None:
-    """A lying round body whose axis is tilted from the table (a mug resting on its rim and its
-    handle): circles fitted to the cross-sections of its two halves along a give two axis
-    points; the axis through them is tested like the others. None when it is not a lying axis
-    (tilted by more than 45°)."""
-    s_a = W @ a
-    across = (W - c_top) @ b
-    half = s_a < np.median(s_a)
-    centres = []
-    for m in (half, ~half):
-        fit = _robust_circle(np.column_stack([across[m], z[m]]), 2 * cfg.circle_tolerance)
-        if fit is None:
+def _normal_axis(n: np.ndarray, a0: np.ndarray) -> np.ndarray | None:
+    """The axis of a surface of revolution from its normals: the side wall's normals are
+    (nearly, for a taper) orthogonal to the axis, so the axis is the direction of least normal
+    variance among the normals not along the current estimate (end faces are). Starts from a0;
+    None when the result is not a lying axis (more than 45° from the table plane)."""
+    a = a0 / np.linalg.norm(a0)
+    for _ in range(3):
+        side = np.abs(n @ a) < SIDE_WALL_COSINE
+        if side.sum() < 10:
             return None
-        centres.append(s_a[m].mean() * np.append(a, 0.0)
-                       + np.append((c_top @ b + fit[0][0]) * b, fit[0][1]))
-    axis = centres[1] - centres[0]
-    if np.linalg.norm(axis) < 1e-6 or abs(axis[2]) > np.linalg.norm(axis) * np.sqrt(0.5):
+        _, vecs = np.linalg.eigh(n[side].T @ n[side])
+        a = vecs[:, 0] * (1.0 if vecs[:, 0] @ a >= 0 else -1.0)
+    return a if abs(a[2]) <= np.sqrt(0.5) else None
+
+
+def _tilted_candidate(W: np.ndarray, z: np.ndarray, n: np.ndarray, a: np.ndarray,
+                      b: np.ndarray, gap: float, cfg: CompletionConfig) -> _Candidate | None:
+    """A lying round body whose axis may be tilted from the table (a mug resting on its rim and
+    its handle): the axis direction from the normals (`_normal_axis`, starting along a), the
+    axis point from a circle fitted to the points projected along it. None when the normals do
+    not give a lying axis."""
+    axis = _normal_axis(n, np.append(a, 0.0))
+    if axis is None:
         return None
-    axis = axis / np.linalg.norm(axis)
-    p_A = 0.5 * (centres[0] + centres[1])
+    p = np.column_stack([W, z])
+    p0 = p.mean(axis=0)
     u = np.append(b, 0.0) - (np.append(b, 0.0) @ axis) * axis
     u = u / np.linalg.norm(u)
     v = np.cross(axis, u)
-    d = np.column_stack([W, z]) - p_A
-    fit = circle_test(np.column_stack([d @ u, d @ v]), cfg)
+    d = p - p0
+    circle = _robust_circle(np.column_stack([d @ u, d @ v]), 2 * cfg.circle_tolerance)
+    if circle is None:
+        return None
     s = d @ axis
-    p_A = p_A + 0.5 * (s.min() + s.max()) * axis  # the middle of the visible extent
+    p_A = p0 + circle[0][0] * u + circle[0][1] * v + 0.5 * (s.min() + s.max()) * axis
+    d = p - p_A
+    fit = circle_test(np.column_stack([d @ u, d @ v]), cfg)
     return _Candidate(False, axis, u, v, fit, p_A, gap)
 
 

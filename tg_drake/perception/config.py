@@ -22,7 +22,8 @@ class SegmentationConfig:
     min_object_height: float = 0.004  # object points are this far above the plane [m].
     max_object_height: float = 0.6  # ... and at most this far [m].
     table_margin: float = 0.0  # objects' points may lie this far outside the table's extent [m].
-    voxel_size: float = 0.004  # object points are averaged per voxel of this side [m].
+    voxel_size: float = 0.004  # object points are averaged per voxel of this side [m] ...
+    max_object_points: int = 1500  # ... or of a larger side that leaves about this many.
     cluster_eps: float = 0.012  # DBSCAN neighbourhood radius [m].
     cluster_min_points: int = 4  # DBSCAN core-point neighbour count (voxels).
     min_cluster_points: int = 40  # smaller clusters are noise (voxels).
@@ -56,8 +57,9 @@ class PoseConfig:
     cavity_depth_fraction: float = 0.12  # ... or this share of the object height if larger.
     min_cavity_share: float = 0.25  # share of far-side points inside the rim that are deep.
     min_cavity_points: int = 6  # at least this many deep points make a cavity.
-    neck_ratio: float = 0.75  # top radius below this share of the base radius is a neck.
-    taper_ratio: float = 0.92  # top radius below this share of the base radius is a taper.
+    neck_ratio: float = 0.6  # top radius below this share of the base radius is a neck ...
+    neck_body_ratio: float = 0.95  # ... over a body this wide at mid-height (else a taper).
+    taper_ratio: float = 0.95  # top radius below this share of the base radius is a taper.
 
 
 @dataclass

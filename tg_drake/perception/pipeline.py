@@ -58,6 +58,11 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
         raise PerceptionError(
             f"object points lie {-p_T[:, 2].min():.3f} m below the table plane (tolerance "
             f"{BELOW_TABLE_TOLERANCE} m): wrong table frame?")
+    if len(p_T) > cfg.segmentation.max_object_points:
+        # A large object (a pan) is averaged again on a coarser grid: its shape is as clear
+        # and every later step (and the kernel prior's graph) stays fast.
+        grid = cfg.segmentation.voxel_size * np.sqrt(len(p_T) / cfg.segmentation.max_object_points)
+        p_T, _ = voxel_average(p_T, grid)
     n_T = estimate_normals(p_T, np.asarray(p_TC, float), cfg.completion.normal_neighbours)
     c = complete(p_T, n_T, cfg.completion)
     pose = estimate_pose(c, n_T, p_TC, cfg.pose)

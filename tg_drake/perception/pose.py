@@ -144,7 +144,7 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
             p_up, cue = P_UPRIGHT_CAVITY, "cavity"
         elif handle_end != 0:
             p_up, cue = (P_UPRIGHT_HANDLE if handle_end > 0 else 1 - P_UPRIGHT_HANDLE), "handle"
-        elif r_high < cfg.neck_ratio * r_low and r_mid >= cfg.taper_ratio * r_low:
+        elif r_high < cfg.neck_ratio * r_low and r_mid >= cfg.neck_body_ratio * r_low:
             p_up, cue = P_UPRIGHT_NECK, "neck"
         elif r_high < cfg.taper_ratio * r_low:
             p_up, cue = P_UPRIGHT_TAPER, "taper"
