@@ -58,6 +58,7 @@ class CircleFit:
     handle: np.ndarray  # (N,) bool: points outside the circle, in the handle's directions.
     handle_direction: np.ndarray  # (2,) unit direction of the handle in the plane, or zeros.
     rim: np.ndarray  # (M,) int indices of the outline points on the circle.
+    spread: float = np.inf  # relative standard deviation of the outline radius on the circle.
 
 
 @dataclass
@@ -135,8 +136,9 @@ def circle_test(q: np.ndarray, cfg: CompletionConfig) -> CircleFit:
     else:
         handle[:] = False
     rim = np.flatnonzero((rho == outline[k]) & on_circle[k])
+    spread = float(np.std(outline[on_circle]) / radius) if on_circle.any() else np.inf
     return CircleFit(confidence >= cfg.min_circle_fraction, radius, confidence, handle,
-                     direction, rim)
+                     direction, rim, spread)
 
 
 def _rotate_180(p: np.ndarray, p_A: np.ndarray, a: np.ndarray) -> np.ndarray:
@@ -188,7 +190,10 @@ def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = No
             directions.append(evecs_t[:, 1] * (1.0 if evecs_t[0, 1] >= 0 else -1.0))
     candidates = [_vertical_candidate(W, top, c_top, d_z, e1, e2, cfg)]
     # A tilted lying axis is tried along W's long direction and the top ridge only.
-    candidates += [_horizontal_candidate(W, z, c_top, d_z, d, cfg, n_T if i != 1 else None)
+    # (Not when the vertical circle is already perfect: a tilted one could at best tie.)
+    tilt_normals = n_T if candidates[0].fit.confidence < 1.0 else None
+    candidates += [_horizontal_candidate(W, z, c_top, d_z, d, cfg,
+                                         tilt_normals if i != 1 else None)
                    for i, d in enumerate(directions)]
 
     # Choose: the candidate whose cross-section is most surely a circle; between candidates as
@@ -374,8 +379,9 @@ def _tilted_candidate(W: np.ndarray, z: np.ndarray, n: np.ndarray, a: np.ndarray
 
 def _vertical_fit(W: np.ndarray, top: np.ndarray, c: np.ndarray, cfg: CompletionConfig
                   ) -> tuple[CircleFit, np.ndarray]:
-    """Circle test of W about c, then two refinements of c, each kept when it does not lower
-    the test's confidence:
+    """Circle test of W about c, then refinements of c, each kept when it makes the test surer
+    (higher confidence, then a rounder outline: a circle seen from off its centre has an
+    outline that swings with the direction):
 
     - the top region's centroid without the handle points, once they are known (the paper's
       estimate, cleaned of a handle at rim height);
@@ -384,21 +390,24 @@ def _vertical_fit(W: np.ndarray, top: np.ndarray, c: np.ndarray, cfg: Completion
       camera by a few millimetres, enough to make the body look lopsided; the top region of a
       tilted pan lying upside down is one side of its bottom.
     """
+    def score(f: CircleFit) -> tuple[float, float]:
+        return f.confidence, -f.spread
+
     fit = circle_test(W - c, cfg)
     keep = top & ~fit.handle
     if fit.handle.any() and keep.any():
         c1 = W[keep].mean(axis=0)
         fit1 = circle_test(W - c1, cfg)
-        if fit1.confidence >= fit.confidence:
+        if score(fit1) >= score(fit):
             fit, c = fit1, c1
-    for _ in range(2):
+    for _ in range(3):
         if len(fit.rim) < 3:
             break
         rim = W[fit.rim] - c
         A = np.column_stack([2 * rim, np.ones(len(rim))])
         sol, *_ = np.linalg.lstsq(A, (rim ** 2).sum(axis=1), rcond=None)
         refit = circle_test(W - (c + sol[:2]), cfg)
-        if refit.confidence < fit.confidence or (fit.ok and not refit.ok):
+        if score(refit) <= score(fit):
             break
         fit, c = refit, c + sol[:2]
     return fit, c

@@ -23,7 +23,7 @@ class SegmentationConfig:
     max_object_height: float = 0.6  # ... and at most this far [m].
     table_margin: float = 0.0  # objects' points may lie this far outside the table's extent [m].
     voxel_size: float = 0.004  # object points are averaged per voxel of this side [m] ...
-    max_object_points: int = 1500  # ... or of a larger side that leaves about this many.
+    max_object_points: int = 2000  # ... or of a larger side that leaves about this many.
     cluster_eps: float = 0.012  # DBSCAN neighbourhood radius [m].
     cluster_min_points: int = 4  # DBSCAN core-point neighbour count (voxels).
     min_cluster_points: int = 40  # smaller clusters are noise (voxels).
@@ -59,7 +59,8 @@ class PoseConfig:
     min_cavity_points: int = 6  # at least this many deep points make a cavity.
     neck_ratio: float = 0.6  # top radius below this share of the base radius is a neck ...
     neck_body_ratio: float = 0.95  # ... over a body this wide at mid-height (else a taper).
-    taper_ratio: float = 0.95  # top radius below this share of the base radius is a taper.
+    taper_ratio: float = 0.95  # top radius below this share of the base radius is a taper ...
+    taper_body_ratio: float = 0.98  # ... narrowing already at mid-height (a can's rim does not).
 
 
 @dataclass

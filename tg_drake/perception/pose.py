@@ -15,8 +15,8 @@ direction of the axis gives the pose); its likelihood is the confidence of that 
 3. **Neck.** With no cavity seen, the top is closed. A top much narrower than the base over a
    body as wide as the base at mid-height is a neck: an upright bottle.
 4. **Taper.** A closed top narrower than the base otherwise, narrowing steadily from a rim on the
-   table, is the shape of a tapered open container (glass, cup, bowl) resting on its rim:
-   upside-down.
+   table (already at mid-height: a can's rolled rim narrows only its last centimetre), is the
+   shape of a tapered open container (glass, cup, bowl) resting on its rim: upside-down.
 5. Otherwise (closed and straight, like a can) the object is upright with a weak likelihood:
    standing upright is the usual pose (the paper's S_GRASP and S_ROBOT scenes use only upright
    and sideways), and an upside-down straight container looks the same from above.
@@ -146,7 +146,7 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
             p_up, cue = (P_UPRIGHT_HANDLE if handle_end > 0 else 1 - P_UPRIGHT_HANDLE), "handle"
         elif r_high < cfg.neck_ratio * r_low and r_mid >= cfg.neck_body_ratio * r_low:
             p_up, cue = P_UPRIGHT_NECK, "neck"
-        elif r_high < cfg.taper_ratio * r_low:
+        elif r_high < cfg.taper_ratio * r_low and r_mid < cfg.taper_body_ratio * r_low:
             p_up, cue = P_UPRIGHT_TAPER, "taper"
         else:
             p_up, cue = P_UPRIGHT_STRAIGHT, "straight"

@@ -43,7 +43,9 @@ def box_pregrasps(X_WB: np.ndarray, half_extents: np.ndarray,
     p_grasp = X_WB[:3, 3] + normals * (h[FACE_AXIS] - depth)[:, None]  # (6, 3)
     x_G = R.T[OTHER_AXES[FACE_AXIS]].reshape(12, 3)  # (6, 2, 3) → (12, 3): box edge axes.
     y_G = np.repeat(-normals, 2, axis=0)  # approach: into the face.
-    z_G = np.cross(x_G, y_G)
+    z_G = np.column_stack([x_G[:, 1] * y_G[:, 2] - x_G[:, 2] * y_G[:, 1],  # x_G × y_G
+                           x_G[:, 2] * y_G[:, 0] - x_G[:, 0] * y_G[:, 2],
+                           x_G[:, 0] * y_G[:, 1] - x_G[:, 1] * y_G[:, 0]])
     X = np.zeros((12, 4, 4))
     X[:, :3, 0], X[:, :3, 1], X[:, :3, 2] = x_G, y_G, z_G
     X[:, :3, 3] = np.repeat(p_grasp, 2, axis=0) - np.einsum("nij,j->ni", X[:, :3, :3],
