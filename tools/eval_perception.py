@@ -91,24 +91,22 @@ def _cases(objects) -> Iterator[tuple]:
 
 def station_views(objects) -> Iterator[View]:
     """Views rendered by the Drake station (one station, every object in it)."""
-    from pydrake.math import RigidTransform
-
-    from tg_drake.scenario import Scenario, look_at
-    from tg_drake.station import make_station
-    from pydrake.systems.sensors import CameraConfig
     from pydrake.common.schema import Transform
+    from pydrake.math import RigidTransform
+    from pydrake.systems.sensors import CameraConfig
+
+    from tg_drake.scenario import ObjectPlacement, Scenario, look_at
+    from tg_drake.station import make_station
 
     objects = list(objects)
     scenario = Scenario()
-    scenario.objects = []
-    from tg_drake.scenario import ObjectPlacement
-    for obj in objects:
-        scenario.objects.append(ObjectPlacement(id=obj.id, pose=next(iter(obj.poses))))
+    scenario.objects = [ObjectPlacement(id=obj.id, pose=next(iter(obj.poses))) for obj in objects]
     X_WT = scenario.X_WT.GetDeterministicValue().GetAsMatrix4()
     scenario.cameras = {}
     for name, (az, el, d) in CAMERAS.items():
-        config = CameraConfig(width=WIDTH, height=HEIGHT, name=name, renderer_class="RenderEngineVtk",
-                              rgb=False, depth=True, label=False)
+        config = CameraConfig(width=WIDTH, height=HEIGHT, name=name,
+                              renderer_class="RenderEngineVtk", rgb=False, depth=True,
+                              label=False)
         config.focal = CameraConfig.FovDegrees(y=FOV_Y_DEG)
         config.z_far = config.clipping_far = 3.0
         p_WC = transform(X_WT, camera_position_T(az, el, d)[None])[0]
@@ -156,38 +154,57 @@ def open3d_views(objects) -> Iterator[View]:
                        Truth(obj.id, obj.category, pose, obj.parts, yaw, name))
 
 
+def add_depth_noise(depth: np.ndarray, sigma_1m: float, rng: np.random.Generator) -> np.ndarray:
+    """Gaussian depth noise growing with the square of the range, as a structured-light camera's
+    (Khoshelham & Elberink 2012: about 1.5 mm at 1 m): σ(z) = sigma_1m · (z / 1 m)²."""
+    if sigma_1m <= 0:
+        return depth
+    valid = np.isfinite(depth) & (depth > 0)
+    noisy = depth.astype(np.float64).copy()
+    noisy[valid] += rng.normal(0.0, 1.0, int(valid.sum())) * sigma_1m * noisy[valid] ** 2
+    return noisy.astype(np.float32)
+
+
+def _describe(view: View, depth: np.ndarray, cfg: PerceptionConfig, seg_ms: list, obj_ms: list
+              ) -> dict:
+    t = view.truth
+    rec = {"object": t.object_id, "category": t.category, "pose": t.pose,
+           "yaw_deg": t.yaw_deg, "camera": t.camera, "parts": sorted(t.parts)}
+    try:
+        t0 = time.perf_counter()
+        seg = segment_depth(depth, view.intrinsics, view.X_WC, cfg.segmentation)
+        seg_ms.append(1e3 * (time.perf_counter() - t0))
+        if len(seg.objects_T) != 1:
+            raise PerceptionError(f"{len(seg.objects_T)} objects found, expected 1")
+        p_TC = transform(inverse(seg.X_WT), view.X_WC[:3, 3][None])[0]
+        t0 = time.perf_counter()
+        o = describe_object(seg.objects_T[0], seg.X_WT, p_TC, cfg)
+        obj_ms.append(1e3 * (time.perf_counter() - t0))
+        rec.update(found_pose=o.pose, found_parts=sorted(o.part_probabilities),
+                   pose_likelihood={k: round(v, 3) for k, v in o.pose_likelihood.items()},
+                   part_probabilities={k: round(v, 3) for k, v in o.part_probabilities.items()})
+    except PerceptionError as e:
+        rec.update(found_pose=None, found_parts=None, error=str(e))
+    rec["pose_ok"] = rec["found_pose"] == t.pose
+    rec["parts_ok"] = rec["found_parts"] == sorted(t.parts)
+    return rec
+
+
 def evaluate(views: Iterable[View], cfg: PerceptionConfig | None = None,
-             progress: bool = True) -> tuple[dict, list[dict]]:
-    """Pose and part accuracy over views; returns (summary, one record per view)."""
+             noise_levels: tuple[float, ...] = (0.0,), seed: int = 0, progress: bool = True
+             ) -> dict[float, tuple[dict, list[dict]]]:
+    """Pose and part accuracy over views, for each depth-noise level (σ at 1 m [m]); returns
+    level → (summary, one record per view)."""
     cfg = cfg or PerceptionConfig()
-    records = []
-    seg_ms, obj_ms = [], []
+    rng = np.random.default_rng(seed)
+    runs = {level: ([], [], []) for level in noise_levels}  # records, seg_ms, obj_ms
     for i, view in enumerate(views):
-        t = view.truth
-        rec = {"object": t.object_id, "category": t.category, "pose": t.pose,
-               "yaw_deg": t.yaw_deg, "camera": t.camera, "parts": sorted(t.parts)}
-        try:
-            t0 = time.perf_counter()
-            seg = segment_depth(view.depth, view.intrinsics, view.X_WC, cfg.segmentation)
-            seg_ms.append(1e3 * (time.perf_counter() - t0))
-            if len(seg.objects_T) != 1:
-                raise PerceptionError(f"{len(seg.objects_T)} objects found, expected 1")
-            p_TC = transform(inverse(seg.X_WT), view.X_WC[:3, 3][None])[0]
-            t0 = time.perf_counter()
-            o = describe_object(seg.objects_T[0], seg.X_WT, p_TC, cfg)
-            obj_ms.append(1e3 * (time.perf_counter() - t0))
-            rec.update(found_pose=o.pose, found_parts=sorted(o.part_probabilities),
-                       pose_likelihood={k: round(v, 3) for k, v in o.pose_likelihood.items()},
-                       part_probabilities={k: round(v, 3) for k, v in
-                                           o.part_probabilities.items()})
-        except PerceptionError as e:
-            rec.update(found_pose=None, found_parts=None, error=str(e))
-        rec["pose_ok"] = rec["found_pose"] == t.pose
-        rec["parts_ok"] = rec["found_parts"] == sorted(t.parts)
-        records.append(rec)
+        for level, (records, seg_ms, obj_ms) in runs.items():
+            depth = add_depth_noise(view.depth, level, rng)
+            records.append(_describe(view, depth, cfg, seg_ms, obj_ms))
         if progress and (i + 1) % 50 == 0:
             print(f"  {i + 1} views", file=sys.stderr, flush=True)
-    return summarise(records, seg_ms, obj_ms), records
+    return {level: (summarise(*run), run[0]) for level, run in runs.items()}
 
 
 def _rates(recs: list[dict]) -> dict:
@@ -237,12 +254,21 @@ def markdown(summary: dict, command: str, renderer: str) -> str:
         "",
         "| setting | views | pose [%] | parts [%] |",
         "|---|---:|---:|---:|",
-        f"| paper, S_GRASP_noisy (upright, sideways) | – | 100 | 84.56 |",
-        f"| paper, S_ROBOT (upright, sideways) | – | 100 | 82.14 |",
+        "| paper, S_GRASP_noisy (upright, sideways) | – | 100 | 84.56 |",
+        "| paper, S_ROBOT (upright, sideways) | – | 100 | 82.14 |",
         f"| ours, upright and sideways | {us['n_views']} | {pct(us['pose_accuracy'])} | "
         f"{pct(us['part_accuracy'])} |",
         f"| ours, all suitable poses (with upside-down) | {summary['n_views']} | "
         f"{pct(summary['pose_accuracy'])} | {pct(summary['part_accuracy'])} |",
+    ]
+    for level, r in summary.get("depth_noise", {}).items():
+        u = r["upright_and_sideways"]
+        lines += [
+            f"| ours, depth noise σ = {1e3 * float(level):g} mm at 1 m, upright and sideways | "
+            f"{u['n_views']} | {pct(u['pose_accuracy'])} | {pct(u['part_accuracy'])} |",
+            f"| ours, depth noise σ = {1e3 * float(level):g} mm at 1 m, all poses | "
+            f"{r['n_views']} | {pct(r['pose_accuracy'])} | {pct(r['part_accuracy'])} |"]
+    lines += [
         "",
         "| category | views | pose [%] | parts [%] |",
         "|---|---:|---:|---:|",
@@ -255,8 +281,9 @@ def markdown(summary: dict, command: str, renderer: str) -> str:
         lines.append(f"| {p} | {r['n_views']} | {pct(r['pose_accuracy'])} | "
                      f"{pct(r['part_accuracy'])} |")
     t = summary["timing_ms"]
-    lines += ["", f"Median time per view during this run: segmentation {t['segmentation_median']:.1f} ms "
-              f"(640×480 frame), one object's completion + pose + parts "
+    lines += ["", "Median time per view during this run: segmentation "
+              f"{t['segmentation_median']:.1f} ms (640×480 frame), one object's completion + "
+              "pose + parts "
               f"{t['object_median']:.1f} ms (paper: 27.5 + 15.71 = 43.21 ms). The speed figures "
               "proper come from `tg-drake bench --only perception_ms --only segmentation_ms`.", ""]
     return "\n".join(lines)
@@ -268,14 +295,22 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("docs/results"))
     parser.add_argument("--only", action="append", help="only this object id (repeatable)")
     parser.add_argument("--records", type=Path, help="also write one JSON line per view here")
+    parser.add_argument("--depth-noise", type=float, action="append",
+                        help="also evaluate with Gaussian depth noise of this σ at 1 m [m], "
+                             "growing with range² (repeatable; e.g. 0.0015, a Kinect's)")
     args = parser.parse_args(argv)
     from tg_drake.objects import get_object, load_library
 
     objects = ([get_object(i) for i in args.only] if args.only
                else list(load_library().values()))
     views = station_views(objects) if args.renderer == "station" else open3d_views(objects)
-    summary, records = evaluate(views)
+    levels = (0.0, *(args.depth_noise or ()))
+    runs = evaluate(views, noise_levels=levels)
+    summary, records = runs[0.0]
     summary["renderer"] = args.renderer
+    summary["depth_noise"] = {f"{level:g}": {k: runs[level][0][k] for k in (
+        "n_views", "pose_accuracy", "part_accuracy", "upright_and_sideways", "per_category")}
+        for level in levels[1:]}
     command = "python tools/eval_perception.py" + "".join(
         f" {a}" for a in (argv if argv is not None else sys.argv[1:]))
     summary["command"] = command
@@ -283,7 +318,8 @@ def main(argv: list[str] | None = None) -> int:
     (args.out / "perception.json").write_text(json.dumps(summary, indent=1) + "\n")
     (args.out / "perception.md").write_text(markdown(summary, command, args.renderer))
     if args.records:
-        args.records.write_text("".join(json.dumps(r) + "\n" for r in records))
+        args.records.write_text("".join(json.dumps({"depth_noise": level, **r}) + "\n"
+                                        for level in levels for r in runs[level][1]))
     us = summary["upright_and_sideways"]
     print(f"{summary['n_views']} views: pose {summary['pose_accuracy']:.3f}, parts "
           f"{summary['part_accuracy']:.3f}; upright+sideways: pose {us['pose_accuracy']:.3f}, "

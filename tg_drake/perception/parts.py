@@ -2,18 +2,18 @@
 
 Two kinds of object, as in the paper:
 
-- **Tools**: the symmetry axis is parallel to the table and the visible cross-section is thin
-  (both its sides below `tool_max_thickness`) over a good part of the length
-  (`tool_thin_fraction`): the handle of a hammer or a ladle, all of a knife; a bottle lying down
-  is thin only at its neck. A round body with a handle longer than `tool_handle_ratio` times its
-  diameter is a long-handled tool lying on its head (a ladle on its bowl): the body is its
-  usable area; the circle test's confidence is both parts' probability. A tool has a *handle* and a *usable area*. We split
-  the axis where the cross-section changes most: the two-segment piecewise-constant fit of the
-  cross-section's width and height along the axis with the least squared error. The usable area
-  is the flatter segment (a hammer's head, a knife's blade, a spatula's blade: their cross-section
-  is much wider than thick); when both segments are about as flat, the thicker one is the handle
-  (a screwdriver's grip). Both probabilities are 0.5 + 0.5·(share of the profile's variance the
-  split explains): a clear change of cross-section is a sure split.
+- **Tools** have a *handle* and a *usable area*. A tool's symmetry axis is parallel to the table
+  and its visible cross-section is thin (both its sides below `tool_max_thickness`) over a good
+  part of its length (`tool_thin_fraction`): the handle of a hammer or a ladle, all of a knife; a
+  bottle lying down is thin only at its neck. We split the axis where the cross-section changes
+  most: the two-segment piecewise-constant fit of the cross-section's width and height along the
+  axis with the least squared error. The usable area is the flatter segment (a hammer's head, a
+  knife's blade, a spatula's blade: their cross-section is much wider than thick); when both
+  segments are about as flat, the thicker one is the handle (a screwdriver's grip). Both
+  probabilities are 0.5 + 0.5·(share of the profile's variance the split explains): a clear
+  change of cross-section is a sure split. A round body with a handle longer than
+  `tool_handle_ratio` times its diameter is a long-handled tool lying on its head (a ladle on its
+  bowl): the body is its usable area; the circle test's confidence is both parts' probability.
 - **Other objects**: points outside the fitted circle are the *handle* (paper: "a circle fitted
   in the projected points W with a large confidence; the points lying outside of the circle are
   labeled as handle"); the rest is divided along the axis into *bottom*, *middle* and *top* (the

@@ -6,8 +6,9 @@ plane, z along the plane normal (towards the camera, i.e. up) and x along the in
 direction. Object points are the points above the plane, inside the table's extent; they are
 averaged per voxel and clustered with DBSCAN (Open3D `cluster_dbscan`). Two clusters that touch
 in the image with a short depth step between them are one object whose connection the nearer
-part hides: a pan's handle whose root hides behind the rim. A cluster with a pixel on the image border is cut: by
-default it is dropped, since no completion can recover what the image does not hold.
+part hides: a pan's handle whose root hides behind the rim. A cluster with a pixel on the image
+border is cut: by default it is dropped, since no completion can recover what the image does
+not hold.
 """
 
 from __future__ import annotations
