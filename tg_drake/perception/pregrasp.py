@@ -29,27 +29,32 @@ OTHER_AXES = np.array([[1, 2], [0, 2], [0, 1]])
 
 def box_pregrasps(X_WB: np.ndarray, half_extents: np.ndarray,
                   cfg: PregraspConfig | None = None) -> np.ndarray:
-    """The 12 pre-grasp poses X_WG (12, 4, 4) of one box: for each of its 6 faces, two.
+    """The pre-grasp poses X_WG of boxes: for each of a box's 6 faces, two.
 
     Args:
-        X_WB: 4×4 box pose (centre and axes) in the world.
-        half_extents: (3,) half side lengths along the box axes [m].
+        X_WB: 4×4 box pose (centre and axes) in the world, or (B, 4, 4) for B boxes.
+        half_extents: (3,) half side lengths along the box axes [m], or (B, 3).
+
+    Returns (12, 4, 4) for one box, (12·B, 4, 4) for B boxes (box by box, face by face).
     """
     cfg = cfg or PregraspConfig()
-    R = X_WB[:3, :3]
-    h = np.asarray(half_extents, float)
-    normals = (R[:, FACE_AXIS] * FACE_SIGN).T  # (6, 3) outward face normals in W.
-    depth = np.minimum(cfg.grasp_depth, h[FACE_AXIS])
-    p_grasp = X_WB[:3, 3] + normals * (h[FACE_AXIS] - depth)[:, None]  # (6, 3)
-    x_G = R.T[OTHER_AXES[FACE_AXIS]].reshape(12, 3)  # (6, 2, 3) → (12, 3): box edge axes.
-    y_G = np.repeat(-normals, 2, axis=0)  # approach: into the face.
+    X_WB = np.asarray(X_WB, float).reshape(-1, 4, 4)
+    h = np.asarray(half_extents, float).reshape(-1, 3)
+    B = len(X_WB)
+    R = X_WB[:, :3, :3]  # (B, 3, 3), columns = box axes
+    normals = np.swapaxes(R[:, :, FACE_AXIS] * FACE_SIGN, 1, 2)  # (B, 6, 3) outward normals
+    depth = np.minimum(cfg.grasp_depth, h[:, FACE_AXIS])  # (B, 6)
+    p_grasp = X_WB[:, None, :3, 3] + normals * (h[:, FACE_AXIS] - depth)[..., None]
+    x_G = np.swapaxes(R, 1, 2)[:, OTHER_AXES[FACE_AXIS]].reshape(12 * B, 3)  # box edge axes
+    y_G = np.repeat(-normals.reshape(6 * B, 3), 2, axis=0)  # approach: into the face
     z_G = np.column_stack([x_G[:, 1] * y_G[:, 2] - x_G[:, 2] * y_G[:, 1],  # x_G × y_G
                            x_G[:, 2] * y_G[:, 0] - x_G[:, 0] * y_G[:, 2],
                            x_G[:, 0] * y_G[:, 1] - x_G[:, 1] * y_G[:, 0]])
-    X = np.zeros((12, 4, 4))
+    X = np.zeros((12 * B, 4, 4))
     X[:, :3, 0], X[:, :3, 1], X[:, :3, 2] = x_G, y_G, z_G
-    X[:, :3, 3] = np.repeat(p_grasp, 2, axis=0) - np.einsum("nij,j->ni", X[:, :3, :3],
-                                                            WSG_GRASP_POINT_G)
+    g = WSG_GRASP_POINT_G  # G's origin = grasp point − R_WG · p_G(grasp point)
+    X[:, :3, 3] = (np.repeat(p_grasp.reshape(6 * B, 3), 2, axis=0)
+                   - g[0] * x_G - g[1] * y_G - g[2] * z_G)
     X[:, 3, 3] = 1.0
     return X
 
@@ -60,10 +65,8 @@ def part_pregrasps(boxes: dict[str, tuple[np.ndarray, np.ndarray]], part_index,
 
     `boxes` maps a part name to (X_WB, half extents); `part_index` maps a name to its label.
     """
-    poses, labels = [], []
-    for name, (X_WB, half) in boxes.items():
-        poses.append(box_pregrasps(X_WB, half, cfg))
-        labels.append(np.full(12, part_index(name)))
-    if not poses:
+    if not boxes:
         return np.zeros((0, 4, 4)), np.zeros(0, int)
-    return np.concatenate(poses), np.concatenate(labels)
+    X = box_pregrasps(np.stack([b[0] for b in boxes.values()]),
+                      np.stack([b[1] for b in boxes.values()]), cfg)
+    return X, np.repeat([part_index(name) for name in boxes], 12)
