@@ -60,7 +60,8 @@ class PoseConfig:
     neck_ratio: float = 0.6  # top radius below this share of the base radius is a neck ...
     neck_body_ratio: float = 0.95  # ... over a body this wide at mid-height (else a taper).
     taper_ratio: float = 0.95  # top radius below this share of the base radius is a taper ...
-    taper_body_ratio: float = 0.98  # ... narrowing already at mid-height (a can's rim does not).
+    taper_body_ratio: float = 0.98  # ... narrowing already at mid-height (a can's rim does not)
+    strong_taper_ratio: float = 0.9  # ... or narrowing this much at the top.
 
 
 @dataclass

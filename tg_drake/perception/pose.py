@@ -15,8 +15,9 @@ direction of the axis gives the pose); its likelihood is the confidence of that 
 3. **Neck.** With no cavity seen, the top is closed. A top much narrower than the base over a
    body as wide as the base at mid-height is a neck: an upright bottle.
 4. **Taper.** A closed top narrower than the base otherwise, narrowing steadily from a rim on the
-   table (already at mid-height: a can's rolled rim narrows only its last centimetre), is the
-   shape of a tapered open container (glass, cup, bowl) resting on its rim: upside-down.
+   table (already at mid-height, or strongly at the top: a can's rolled rim narrows only its last
+   centimetre, and only a little), is the shape of a tapered open container (glass, cup, bowl,
+   pan) resting on its rim: upside-down.
 5. Otherwise (closed and straight, like a can) the object is upright with a weak likelihood:
    standing upright is the usual pose (the paper's S_GRASP and S_ROBOT scenes use only upright
    and sideways), and an upside-down straight container looks the same from above.
@@ -54,8 +55,9 @@ INWARD_CENTRE_COSINE = 0.3
 RADIUS_QUANTILE = 0.95
 # Each end's slice is this share of the object's length along the axis.
 END_SLICE = 0.15
-# A handle whose centroid lies in this share of the body's length next to one end is at that end.
-HANDLE_END = 0.3
+# A handle whose centroid lies in this share of the body's length next to one end is at that end
+# (a pan's or pot's handle at the rim: 0.85–1.1 of the way up; a cup's spans 0.3–0.8: 0.5–0.55).
+HANDLE_END = 0.4
 # Two ends whose radii differ by less than this share are equal.
 EQUAL_ENDS = 0.05
 
@@ -146,7 +148,8 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
             p_up, cue = (P_UPRIGHT_HANDLE if handle_end > 0 else 1 - P_UPRIGHT_HANDLE), "handle"
         elif r_high < cfg.neck_ratio * r_low and r_mid >= cfg.neck_body_ratio * r_low:
             p_up, cue = P_UPRIGHT_NECK, "neck"
-        elif r_high < cfg.taper_ratio * r_low and r_mid < cfg.taper_body_ratio * r_low:
+        elif r_high < cfg.taper_ratio * r_low and (r_mid < cfg.taper_body_ratio * r_low
+                                                   or r_high < cfg.strong_taper_ratio * r_low):
             p_up, cue = P_UPRIGHT_TAPER, "taper"
         else:
             p_up, cue = P_UPRIGHT_STRAIGHT, "straight"
