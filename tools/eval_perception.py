@@ -214,6 +214,16 @@ def _rates(recs: list[dict]) -> dict:
             "part_accuracy": sum(r["parts_ok"] for r in recs) / n if n else None}
 
 
+def failures(records: list[dict], n: int = 12) -> list[dict]:
+    """The most frequent failures: (object, true pose, found pose, found parts) with counts."""
+    counts = collections.Counter(
+        (r["object"], r["pose"], r["found_pose"], ", ".join(r["found_parts"] or [])
+         if r["found_parts"] is not None else r.get("error", ""))
+        for r in records if not (r["pose_ok"] and r["parts_ok"]))
+    return [{"object": o, "pose": p, "found_pose": fp, "found_parts": fpa, "views": c}
+            for (o, p, fp, fpa), c in counts.most_common(n)]
+
+
 def summarise(records: list[dict], seg_ms: list[float], obj_ms: list[float]) -> dict:
     by_cat = collections.defaultdict(list)
     by_pose = collections.defaultdict(list)
@@ -231,6 +241,7 @@ def summarise(records: list[dict], seg_ms: list[float], obj_ms: list[float]) -> 
         cameras={n: {"azimuth_deg": a, "elevation_deg": e, "distance_m": d}
                  for n, (a, e, d) in CAMERAS.items()},
         yaws_deg=list(YAWS_DEG),
+        failures=failures(records),
         timing_ms={"segmentation_median": statistics.median(seg_ms) if seg_ms else None,
                    "object_median": statistics.median(obj_ms) if obj_ms else None},
         paper=PAPER)
@@ -280,6 +291,11 @@ def markdown(summary: dict, command: str, renderer: str) -> str:
     for p, r in summary["per_pose"].items():
         lines.append(f"| {p} | {r['n_views']} | {pct(r['pose_accuracy'])} | "
                      f"{pct(r['part_accuracy'])} |")
+    lines += ["", "Most frequent failures (of 12 views per object and pose):", "",
+              "| object | true pose | found pose | found parts | views |", "|---|---|---|---|---:|"]
+    for f in summary.get("failures", []):
+        lines.append(f"| {f['object']} | {f['pose']} | {f['found_pose']} | {f['found_parts']} | "
+                     f"{f['views']} |")
     t = summary["timing_ms"]
     lines += ["", "Median time per view during this run: segmentation "
               f"{t['segmentation_median']:.1f} ms (640×480 frame), one object's completion + "
