@@ -18,13 +18,24 @@ from pathlib import Path
 
 import numpy as np
 
-from tg_drake.errors import TgDrakeError
+from tg_drake.errors import (GraspingError, KernelError, PerceptionError, PlanningError,
+                             RuleError, SimulationError, TgDrakeError)
 
 HELP = "run the whole pipeline on a scenario: perceive, reason, score, plan, grasp, place"
 
 OUTCOME_STATUSES = ("placed", "lifted", "grasped", "failed")
 FAILURE_REASONS = ("unreachable", "perception", "logic", "slipped", "missed", "collision",
                    "simulation", "timeout")
+
+
+# The failure reason a stage's error stands for.
+REASON_OF_ERROR = ((PerceptionError, "perception"), (KernelError, "perception"),
+                   (RuleError, "logic"), (GraspingError, "logic"),
+                   (PlanningError, "unreachable"), (SimulationError, "simulation"))
+
+
+def reason_of(error: TgDrakeError) -> str:
+    return next((r for cls, r in REASON_OF_ERROR if isinstance(error, cls)), "simulation")
 
 
 @dataclass
@@ -122,8 +133,7 @@ def run_scenario(scenario, *, scenario_path: str = "", meshcat=None, images_dir:
             if len(ranked.score) == 0 or not np.any(ranked.score > 0):
                 outcome = Outcome("failed", "logic", "no pre-grasp hypothesis with a non-zero score")
     except TgDrakeError as e:
-        outcome = Outcome("failed", "perception" if "erception" in type(e).__name__ else "logic",
-                          str(e))
+        outcome = Outcome("failed", reason_of(e), str(e))
 
     if images_dir is not None and "perception" in result:
         _write_images(images_dir, station, context, pipeline, camera)
@@ -208,6 +218,8 @@ def _execute(simulator, pipeline, scenario, result, timings, visualizer) -> Outc
         if ok:
             return Outcome("placed", "", detail, **common)
         return Outcome("lifted", "slipped", detail, **common)
+    except TgDrakeError as e:  # a stage failed while the planner re-queried it
+        return Outcome("failed", reason_of(e), str(e))
     except RuntimeError as e:
         return Outcome("failed", "simulation", f"the simulation failed: {e}")
     finally:
