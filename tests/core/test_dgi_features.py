@@ -106,9 +106,28 @@ def test_cylinder_depth_follows_its_circle():
     assert dgi[:, 0].max() == pytest.approx(0.0392297 + 1.0, abs=1e-4)
 
 
+def test_features_scale_depths_and_keep_empty_pixels_apart():
+    # The step: DI 0.03 / 0.05 m; features measure from the volume's back face (0.021 m behind the
+    # base) at 25 units per metre: 1.275 and 1.775; the DGI is taken of those.
+    x, z = grid((-0.08, 0.08), (-0.0105, 0.0105))
+    p_G = in_gripper(x, np.where(x < 0, 0.03, 0.05), z)
+    f = dgi_features(p_G, np.eye(4))[0]
+    n_di = CFG.n_u * CFG.n_v
+    expected = np.repeat(np.r_[np.full(10, 1.275), np.full(10, 1.775)][:, None], 3, axis=1)
+    np.testing.assert_allclose(f[:n_di].reshape(20, 3), expected, atol=1e-12)
+    expected_dgi = np.zeros(18)
+    expected_dgi[[8, 9]] = 0.5
+    np.testing.assert_allclose(f[n_di:], expected_dgi, atol=1e-12)
+    # An object reaching 1 cm into the palm is at 0.275 units; empty stays −1.
+    p_G = in_gripper(x[x < 0], np.full(np.sum(x < 0), -0.01), z[x < 0])
+    f = dgi_features(p_G, np.eye(4))[0, :n_di].reshape(20, 3)
+    np.testing.assert_allclose(f[:10], 0.275, atol=1e-12)
+    np.testing.assert_array_equal(f[10:], EMPTY_DEPTH)
+
+
 def test_empty_volume_gives_minus_one_and_zero_gradient():
     x, z = grid((-0.08, 0.08), (-0.03, 0.03))
-    behind_palm = in_gripper(x, np.full_like(x, -0.01), z)  # behind the gripper base
+    behind_palm = in_gripper(x, np.full_like(x, -0.022), z)  # behind the volume's back face
     past_tips = in_gripper(x, np.full_like(x, FINGERTIP_Y - GRIPPER_BASE_Y + 0.001), z)
     beside = in_gripper(x, np.full_like(x, 0.03), z + 0.05)  # beyond the pads' width
     for cloud in (behind_palm, past_tips, beside):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from tg_drake.errors import GraspingError
-from tg_drake.grasping.dgi import PAD_CENTER_Y, dgi_features
+from tg_drake.grasping.dgi import PAD_CENTER_Y, depth_images
 from tg_drake.grasping.hypotheses import (
     BODY_BOX,
     GRASP_INSET,
@@ -49,13 +49,13 @@ def test_two_grasps_per_face_approach_the_box_centre():
     # A thin plate grasped through its thin side puts the plate across the middle of the pads.
     p = np.stack(np.meshgrid(np.linspace(-0.04, 0.04, 81), np.linspace(-0.04, 0.04, 81),
                              [0.0]), -1).reshape(-1, 3) * [1, 1, 0] + [0.1, 0.2, 0.3]
-    f = dgi_features(p, box_grasps(X_WB, np.array([0.04, 0.04, 0.0]))[8:9])  # face +z
+    di = depth_images(p, box_grasps(X_WB, np.array([0.04, 0.04, 0.0]))[8:9])  # face +z
     # Approaching along −z, closing along x: the pixels over the plate (|x| ≤ 0.04 m: columns
     # 4..15 of 7 mm from −0.070 m) see it at depth PAD_CENTER_Y − base = 0.041 m, the rest is
     # empty. 1e-12 m: the plate lies exactly in the grasp point's plane.
     expected = np.full((20, 3), -1.0)
     expected[4:16] = PAD_CENTER_Y - 0.014
-    np.testing.assert_allclose(f[0, :60].reshape(20, 3), expected, atol=1e-12)
+    np.testing.assert_allclose(di[0], expected, atol=1e-12)
     with pytest.raises(GraspingError, match="3 half extents"):
         box_grasps(X_WB, np.array([0.1, 0.1]))
 

@@ -58,6 +58,8 @@ def test_a_centred_grasp_holds_through_lift_and_shake(world):
     assert 0.055 < result["finger_gap"] < 0.066
     # 10 mm: the object may slip a little in the pads while it is lifted 0.1 m and shaken.
     assert result["object_rise"] == pytest.approx(0.1, abs=0.01)
+    assert result["touches_left_pad"] and result["touches_right_pad"]
+    assert not result["touches_table"]
 
 
 def test_a_grasp_beside_the_object_closes_on_nothing(world):
@@ -65,6 +67,20 @@ def test_a_grasp_beside_the_object_closes_on_nothing(world):
     assert result["status"] == "ok" and not result["success"]
     assert result["finger_gap"] < 0.002  # fully closed
     assert abs(result["object_rise"]) < 0.005  # the cylinder still stands on the table
+    assert result["touches_table"] and not result["touches_left_pad"]
+
+
+def test_fingers_that_land_on_a_wide_face_do_not_grasp(tmp_path):
+    # A 15 × 15 × 4 cm slab, wider than the 11 cm opening: the fingertips land on its top face
+    # (the gripper stops there, its push limited to 150 N) and close on nothing once lifted.
+    path = tmp_path / "slab.sdf"
+    path.write_text(CYLINDER_SDF.replace("<cylinder><radius>0.033</radius><length>0.1</length>"
+                                         "</cylinder>", "<box><size>0.15 0.15 0.04</size></box>"))
+    X = np.eye(4)
+    X[2, 3] = 0.02
+    result = GraspWorld(str(path)).run(X, top_down([0, 0, 0.04 + 0.03]))
+    assert result["status"] == "ok" and not result["success"]
+    assert result["finger_gap"] < 0.002 and result["touches_table"]
 
 
 def test_a_grasp_on_the_rim_with_the_fingertips_slips(world):

@@ -9,7 +9,9 @@ For a gripper pose ``X_WG`` and an object point cloud ``p_W`` the feature is com
    each pixel holds the minimum depth of the points in its cell, −1 where the cell is empty
    (paper eq. 3: an orthogonal projection of the closest point to the gripper base);
 4. the depth gradient image by central differences on the interior pixels (paper eqs. 4–6):
-   DGI(u, v) = sqrt((DI(u+1, v) − DI(u−1, v))² + (DI(u, v+1) − DI(u, v−1))²).
+   DGI(u, v) = sqrt((DI(u+1, v) − DI(u−1, v))² + (DI(u, v+1) − DI(u, v−1))²);
+5. the feature vector: DI and DGI pixels, with depths rescaled so that an RBF kernel weighs depth
+   differences against empty pixels (`feature_depth_images`).
 
 Everything is vectorised over many hypotheses (M gripper poses) and points (N): no Python loop
 over points or poses.
@@ -51,8 +53,8 @@ class DgiConfig:
     """The closing volume and its pixel grid, in the gripper frame G.
 
     The volume is the box swept by the pads as they close, pads included: x_G over the full
-    opening plus the pads' thickness, y_G from the palm to the fingertips (the depth axis,
-    depth = y_G − base_y), z_G over the pad width. The pixel grid covers it with `n_u` × `n_v`
+    opening plus the pads' thickness, y_G from just behind the palm to the fingertips (the depth
+    axis, depth = y_G − base_y), z_G over the pad width. The pixel grid covers it with `n_u` × `n_v`
     square cells of side `cell_size`, centred on x_G = z_G = 0.
     """
 
@@ -61,13 +63,20 @@ class DgiConfig:
     # one open pad to the other's, so that the DI also shows what the pads land on.
     n_v: int = 3  # pixels along z_G: 3 × 7 mm = 21 mm ⊇ the 20 mm pad width.
     base_y: float = GRIPPER_BASE_Y  # y_G of the gripper base (depth 0) [m].
+    palm_margin: float = 0.021  # the volume starts this far behind the base (3 cells) [m]: an
+    # object that reaches into the palm shows as a negative depth (−0.021 to 0), the gripper
+    # body hitting it. 0 gives the paper's volume, from the base to the fingertips.
+    depth_scale: float = 25.0  # feature units per metre of depth (see `dgi_features`) [1/m].
     tip_y: float = FINGERTIP_Y  # y_G of the fingertips (largest depth) [m].
 
     def __post_init__(self):
-        if not (self.cell_size > 0 and self.tip_y > self.base_y):
+        if not (self.cell_size > 0 and self.tip_y > self.base_y and 0 <= self.palm_margin < 1):
             raise GraspingError(
-                f"bad DgiConfig: cell_size {self.cell_size} must be > 0 and tip_y {self.tip_y} "
-                f"> base_y {self.base_y}")
+                f"bad DgiConfig: need cell_size {self.cell_size} > 0, tip_y {self.tip_y} > "
+                f"base_y {self.base_y}, 0 ≤ palm_margin {self.palm_margin} < 1 m (depths must "
+                "stay above the empty value −1)")
+        if not self.depth_scale > 0:
+            raise GraspingError(f"bad DgiConfig: depth_scale {self.depth_scale} must be > 0")
         if self.n_u < 3 or self.n_v < 3:
             raise GraspingError(
                 f"bad DgiConfig: n_u = {self.n_u} and n_v = {self.n_v} must be ≥ 3 for central "
@@ -136,13 +145,14 @@ def closing_volume_mask(p_G: np.ndarray, config: DgiConfig = DgiConfig()) -> np.
     z = p_G[..., PAD_WIDTH_AXIS]
     return ((x >= -config.half_extent_x) & (x < config.half_extent_x)
             & (z >= -config.half_extent_z) & (z < config.half_extent_z)
-            & (y >= config.base_y) & (y < config.tip_y))
+            & (y >= config.base_y - config.palm_margin) & (y < config.tip_y))
 
 
 def depth_images(p_W: np.ndarray, X_WG: np.ndarray, config: DgiConfig = DgiConfig()) -> np.ndarray:
     """DI for every gripper pose: (M, n_u, n_v) minimum depth per cell [m], EMPTY_DEPTH if empty.
 
-    Pixel u runs along +x_G, pixel v along +z_G; depth = y_G − base_y ∈ [0, depth_range).
+    Pixel u runs along +x_G, pixel v along +z_G; depth = y_G − base_y ∈ [−palm_margin,
+    depth_range).
     """
     p_G = points_in_gripper_frame(p_W, X_WG)
     M = p_G.shape[0]
@@ -171,9 +181,23 @@ def depth_gradient_images(di: np.ndarray) -> np.ndarray:
     return np.sqrt(di_u**2 + di_v**2)
 
 
+def feature_depth_images(di: np.ndarray, config: DgiConfig = DgiConfig()) -> np.ndarray:
+    """DI in feature units: depth measured from the volume's back face, times `depth_scale`;
+    empty pixels stay at EMPTY_DEPTH.
+
+    In metres, the empty value −1 lies a metre below every depth, so that an RBF kernel on raw DIs
+    sees whether pixels are empty and hardly how deep they are. Here the volume spans
+    [0, (palm_margin + depth_range) · depth_scale) = [0, 2.6) units at the defaults, and empty is one
+    unit (4 cm) below its back face.
+    """
+    di = np.asarray(di, dtype=float)
+    return np.where(di == EMPTY_DEPTH, EMPTY_DEPTH, (di + config.palm_margin) * config.depth_scale)
+
+
 def dgi_features(p_W: np.ndarray, X_WG: np.ndarray, config: DgiConfig = DgiConfig()) -> np.ndarray:
-    """Feature vectors (M, config.n_features): the DI pixels then the DGI pixels, row-major."""
-    di = depth_images(p_W, X_WG, config)
+    """Feature vectors (M, config.n_features): the DI pixels then the DGI pixels, row-major, both
+    in feature units (`feature_depth_images`; the DGI is taken of the scaled DI)."""
+    di = feature_depth_images(depth_images(p_W, X_WG, config), config)
     dgi = depth_gradient_images(di)
     M = di.shape[0]
     return np.concatenate([di.reshape(M, -1), dgi.reshape(M, -1)], axis=1)

@@ -19,13 +19,15 @@ An episode (all times in seconds, `EpisodeConfig`):
 2. close: the finger set points move past the centre, so each pad presses with up to
    `grip_force` [N] (the drive's effort limit caps it at 80 N);
 3. lift: the gripper rises `lift_height` along +z_W;
-4. shake: a horizontal circle of radius `shake_amplitude` and a rotation about the pads' axis
-   z_G, `shake_cycles` times, under a sin² envelope so that it starts and stops at rest.
+4. shake: a horizontal circle of radius `shake_amplitude` and a rotation about z_G (across the
+   pads), `shake_cycles` times, under a sin² envelope so that it starts and stops at rest.
 
-Label: success when at the end the object is still between the fingers — the finger gap is above
-`min_finger_gap` and the object rose at least `min_lift_fraction` of the lift height. A run whose
-physics fails (solver error, NaN, the object falling through the table or flying off) is reported
-with status "sim_error" and its reason instead of a label.
+Label: success when at the end the object is held between the fingers: the fingers closed onto
+something (their gap ended between `min_finger_gap` and the full opening less `min_finger_travel`
+on each side — fingers that never moved cannot hold anything, even if pressing their tips on a
+face carried the object up) and the object no longer touches the table. A run whose physics fails
+(solver error, NaN, the object falling through the table or flying off) is reported with status
+"sim_error" and its reason instead of a label.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
 from pydrake.multibody.tree import (
+    BodyIndex,
     FixedOffsetFrame,
     PdControllerGains,
     PrismaticJoint,
@@ -80,8 +83,8 @@ class EpisodeConfig:
     carrier_kd_rotation: float = 20.0  # [N·m·s/rad]
     carrier_force_limit: float = 150.0  # [N] per translation joint: an arm pushes no harder.
     carrier_torque_limit: float = 15.0  # [N·m] per rotation joint.
-    min_finger_gap: float = 0.002  # an object is between the fingers if they stop this far apart [m].
-    min_lift_fraction: float = 0.5  # ... and it rose this share of lift_height.
+    min_finger_gap: float = 0.002  # fingers closer than this closed on nothing [m].
+    min_finger_travel: float = 0.005  # each finger must have closed at least this much [m].
 
     @property
     def duration(self) -> float:
@@ -235,6 +238,12 @@ class GraspWorld:
         self.wsg = wsg
         self.fingers = [plant.GetJointByName(n, wsg) for n in FINGER_JOINTS]
         self.carrier = [plant.GetJointByName(n, wsg) for n in CARRIER_JOINTS]
+        self._body_of = {g: body.index() for body in
+                         (plant.get_body(BodyIndex(i)) for i in range(plant.num_bodies()))
+                         for g in plant.GetCollisionGeometriesForBody(body)}
+        self._named_bodies = {"table": plant.GetBodyByName("table_top", table).index(),
+                              "left_pad": plant.GetBodyByName("left_finger", wsg).index(),
+                              "right_pad": plant.GetBodyByName("right_finger", wsg).index()}
         self.simulator = Simulator(self.diagram)
         self.context = self.simulator.get_mutable_context()
         self._default_state = self.context.get_discrete_state_vector().CopyToVector()
@@ -279,12 +288,31 @@ class GraspWorld:
         if result["status"] == "ok":
             gap = self.fingers[1].get_translation(plant_context) \
                 - self.fingers[0].get_translation(plant_context)
-            rise = self.plant.EvalBodyPoseInWorld(plant_context, self.object_body).translation()[2] - z0
+            X_WO_end = self.plant.EvalBodyPoseInWorld(plant_context, self.object_body)
+            touching = self._object_contacts(plant_context)
+            closed_on_it = c.min_finger_gap < gap < MAX_OPENING - 2 * c.min_finger_travel
             result.update(
-                success=bool(gap > c.min_finger_gap and rise > c.min_lift_fraction * c.lift_height),
-                finger_gap=float(gap), object_rise=float(rise))
+                success=bool(closed_on_it and not touching["table"]),
+                finger_gap=float(gap),
+                object_rise=float(X_WO_end.translation()[2] - z0),
+                touches_table=touching["table"],
+                touches_left_pad=touching["left_pad"],
+                touches_right_pad=touching["right_pad"])
         result["wall_time"] = time.perf_counter() - start
         return result
+
+    def _object_contacts(self, plant_context) -> dict[str, bool]:
+        """Whether the object touches the table and each pad (any contact model)."""
+        results = self.plant.get_contact_results_output_port().Eval(plant_context)
+        pairs = set()
+        for i in range(results.num_hydroelastic_contacts()):
+            surface = results.hydroelastic_contact_info(i).contact_surface()
+            pairs.add(frozenset((self._body_of[surface.id_M()], self._body_of[surface.id_N()])))
+        for i in range(results.num_point_pair_contacts()):
+            info = results.point_pair_contact_info(i)
+            pairs.add(frozenset((info.bodyA_index(), info.bodyB_index())))
+        obj = self.object_body.index()
+        return {name: frozenset((obj, body)) in pairs for name, body in self._named_bodies.items()}
 
     def _check(self, plant_context, z0: float) -> str | None:
         """Why the physics failed, or None."""
