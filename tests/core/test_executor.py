@@ -1,4 +1,4 @@
-"""The executor interface: JSON Lines as jobs finish, resumable, failures recorded, never stopped."""
+"""The executor interface: JSON Lines as jobs finish, resumable, failures recorded, not fatal."""
 
 import importlib.util
 import json

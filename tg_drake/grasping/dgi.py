@@ -122,7 +122,8 @@ def _check_inputs(p_W: np.ndarray, X_WG: np.ndarray) -> tuple[np.ndarray, np.nda
     if np.any(err > 1e-6):
         bad = int(np.argmax(err))
         raise GraspingError(
-            f"gripper pose X_WG[{bad}] has a rotation that is not orthonormal (error {err[bad]:.2g})")
+            f"gripper pose X_WG[{bad}] has a rotation that is not orthonormal "
+            f"(error {err[bad]:.2g})")
     return p_W, X_WG
 
 
@@ -187,8 +188,8 @@ def feature_depth_images(di: np.ndarray, config: DgiConfig = DgiConfig()) -> np.
 
     In metres, the empty value −1 lies a metre below every depth, so that an RBF kernel on raw DIs
     sees whether pixels are empty and hardly how deep they are. Here the volume spans
-    [0, (palm_margin + depth_range) · depth_scale) = [0, 2.6) units at the defaults, and empty is one
-    unit (4 cm) below its back face.
+    [0, (palm_margin + depth_range) · depth_scale) = [0, 2.6) units at the defaults, and empty
+    is one unit (4 cm) below its back face.
     """
     di = np.asarray(di, dtype=float)
     return np.where(di == EMPTY_DEPTH, EMPTY_DEPTH, (di + config.palm_margin) * config.depth_scale)

@@ -5,13 +5,13 @@ module under tg_drake/grasping/ that builds a Drake diagram; the cores (dgi.py, 
 hypotheses.py) never import it.
 
 The world: the table of models/table/table.sdf with its top at z_W = 0, one object resting on it,
-and the WSG 50 of models/wsg_50/wsg_50.sdf carried by six actuated joints — three prismatic and three
-revolute — on a frame F welded to the world at the grasp pose X_WG. The joints therefore measure
-the gripper's displacement from the grasp pose, expressed in the grasp frame, and are zero at the
-grasp; no parametrisation singularity occurs for any grasp orientation. Every joint is PD-controlled
-through its JointActuator gains with the desired state on the plant's `desired_state` input port
-(implicit in SAP, robot_facts.md); gravity is off for the gripper's bodies, which stand in for an
-arm that compensates it.
+and the WSG 50 of models/wsg_50/wsg_50.sdf carried by six actuated joints — three prismatic and
+three revolute — on a frame F welded to the world at the grasp pose X_WG. The joints therefore
+measure the gripper's displacement from the grasp pose, expressed in the grasp frame, and are zero
+at the grasp; no parametrisation singularity occurs for any grasp orientation. Every joint is
+PD-controlled through its JointActuator gains with the desired state on the plant's
+`desired_state` input port (implicit in SAP, robot_facts.md); gravity is off for the gripper's
+bodies, which stand in for an arm that compensates it.
 
 An episode (all times in seconds, `EpisodeConfig`):
 

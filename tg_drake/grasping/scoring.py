@@ -1,4 +1,4 @@
-"""The final grasp score: the logic's P(part | task) times the DGI model's P(grasp | local shape)."""
+"""The final grasp score: the logic's P(part | task) times the DGI's P(grasp | local shape)."""
 
 from __future__ import annotations
 

@@ -7,13 +7,13 @@ the parametric sigmoid (paper eq. 9)
 
 with A and b fitted by maximum likelihood (Platt 1999) on decision values of *held-out* folds: the
 training set is split in `n_folds` stratified folds, an SVM trained on the other folds gives the
-decision values of each fold, and the sigmoid is fitted to all of them. The final SVM is then trained
-on the whole set. We fit the sigmoid ourselves rather than use `SVC(probability=True)`, whose
-internal cross-validation is separate from its decision function, so that its probabilities can
-disagree with its predictions; here `predict` is exactly `predict_proba(X)[:, 1] ≥ 0.5`.
+decision values of each fold, and the sigmoid is fitted to all of them. The final SVM is then
+trained on the whole set. We fit the sigmoid ourselves rather than use `SVC(probability=True)`,
+whose internal cross-validation is separate from its decision function, so that its probabilities
+can disagree with its predictions; here `predict` is exactly `predict_proba(X)[:, 1] ≥ 0.5`.
 
-Note the sign: with labels 1 = success, f grows with the success margin, so the fitted A is negative.
-(The paper reports A = 2, b = 0.5, which implies the opposite sign convention for f.)
+Note the sign: with labels 1 = success, f grows with the success margin, so the fitted A is
+negative. (The paper reports A = 2, b = 0.5, which implies the opposite sign convention for f.)
 """
 
 from __future__ import annotations
