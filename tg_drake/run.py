@@ -141,6 +141,10 @@ def run_scenario(scenario, *, scenario_path: str = "", meshcat=None, images_dir:
     if outcome is None:
         outcome = _execute(simulator, pipeline, scenario, result, timings, visualizer)
     result["outcome"] = asdict(outcome)
+    X_WG = result.pop("grasp_X_WG", None)
+    if images_dir is not None and X_WG is not None:
+        save_grasp_png(scene.objects[scene.target], X_WG, images_dir / "grasp.png",
+                       title=_grasp_title(result))
     timings["total"] = time.perf_counter() - t_start
     result["timings"] = {k: round(v, 4) for k, v in timings.items()}
     return result
@@ -182,6 +186,7 @@ def _execute(simulator, pipeline, scenario, result, timings, visualizer) -> Outc
         ranked = pipeline.ports["ranked_grasps"].Eval(
             pipeline.scoring.GetMyContextFromRoot(context))
         i = status.candidate
+        result["grasp_X_WG"] = np.asarray(status.X_WG, float)  # for the picture; not in JSON
         result["grasp"] = {**_xyz_rpy(status.X_WG), "part": status.part,
                            "p_part": float(ranked.p_part[i]) if i is not None else None,
                            "p_local": float(ranked.p_local[i]) if i is not None else None,
@@ -266,6 +271,65 @@ def _write_images(folder: Path, station, context, pipeline, camera) -> None:
         pipeline.target.GetMyContextFromRoot(context))
     from tg_drake.perception.plot import save_scene_png
     save_scene_png(scene.objects, folder / "parts.png")
+
+
+# The open WSG's finger pads in G (models/wsg_50: 0.012 × 0.082 × 0.02 m boxes centred 0.055 m
+# along +y_G, inner faces at x = ±0.055) and its body box, for the grasp picture.
+_PADS_G = [((-0.061, 0.055, 0.0), (0.012, 0.082, 0.02)), ((0.061, 0.055, 0.0), (0.012, 0.082, 0.02))]
+_BODY_G = ((0.0, -0.0213, 0.0), (0.146, 0.0725, 0.05))
+
+
+def _box_edges(X_WG: np.ndarray, centre, size) -> list[np.ndarray]:
+    """The 12 edges of a box given in G, as (2, 3) world segments."""
+    c, h = np.asarray(centre), np.asarray(size) / 2
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * h + c
+    corners_W = corners @ X_WG[:3, :3].T + X_WG[:3, 3]
+    return [corners_W[[i, j]] for i in range(8) for j in range(i + 1, 8)
+            if np.sum(np.abs(np.sign(corners[i] - c) - np.sign(corners[j] - c))) == 2]
+
+
+def save_grasp_png(obj, X_WG: np.ndarray, path: Path, *, title: str = "") -> Path:
+    """The target's part-coloured cloud in the world with the chosen gripper pose drawn as boxes
+    (finger pads black, body grey) and its approach direction."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from tg_drake.types import PART_COLORS
+
+    fig = plt.figure(figsize=(5, 5))
+    ax = fig.add_subplot(projection="3d")
+    idx = np.random.default_rng(0).permutation(len(obj.p_W))[:5000]
+    ax.scatter(*obj.p_W[idx].T, c=np.asarray(PART_COLORS)[obj.labels[idx]], s=2,
+               depthshade=False, linewidths=0)
+    for centre, size in _PADS_G:
+        for e in _box_edges(X_WG, centre, size):
+            ax.plot(*e.T, color="black", linewidth=1.2)
+    for e in _box_edges(X_WG, *_BODY_G):
+        ax.plot(*e.T, color="0.5", linewidth=0.8)
+    grasp_point = X_WG[:3, 3] + 0.055 * X_WG[:3, 1]
+    ax.quiver(*(grasp_point - 0.12 * X_WG[:3, 1]), *(0.08 * X_WG[:3, 1]), color="black")
+    centre = obj.X_WO[:3, 3]
+    half = max(0.5 * float(np.max(obj.extents)), 0.12)
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(max(centre[2] - half, -0.01), centre[2] + 2 * half)
+    ax.set_box_aspect((1, 1, 1.5))
+    ax.set_xlabel("x_W [m]")
+    ax.set_ylabel("y_W [m]")
+    ax.set_zlabel("z_W [m]")
+    ax.set_title(title, fontsize=8)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def _grasp_title(result: dict) -> str:
+    g = result["grasp"]
+    return (f"grasp on {g['part']}: score {g['score']:.2f} = P(part|task) {g['p_part']:.2f} × "
+            f"P(grasp|shape) {g['p_local']:.2f}\noutcome: {result['outcome']['status']}")
 
 
 def summary(result: dict) -> str:
