@@ -60,14 +60,30 @@ def hand_contact(plant, plant_context, *, object_body, wsg_instance) -> HandCont
     return HandContact(float(q[1] - q[0]), touches_left, touches_right, surfaces)
 
 
+def touches_table(plant, plant_context, *, object_body, table_instance) -> bool:
+    """Does the object touch the table top (any hydroelastic surface or point pair)?"""
+    results = plant.get_contact_results_output_port().Eval(plant_context)
+    obj = set(plant.GetCollisionGeometriesForBody(object_body))
+    table = {g for b in plant.GetBodyIndices(table_instance)
+             for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))}
+    pairs = [(results.hydroelastic_contact_info(i).contact_surface().id_M(),
+              results.hydroelastic_contact_info(i).contact_surface().id_N())
+             for i in range(results.num_hydroelastic_contacts())]
+    pairs += [(results.point_pair_contact_info(i).point_pair().id_A,
+               results.point_pair_contact_info(i).point_pair().id_B)
+              for i in range(results.num_point_pair_contacts())]
+    return any((a in obj and b in table) or (b in obj and a in table) for a, b in pairs)
+
+
 def placed(X_WO_picked, X_WO_now, p_W_target_xy, *, released: bool) -> tuple[bool, str]:
-    """Is the object standing at the place target, in the pose it was picked in, and let go?"""
+    """Is the object standing at the place target, in the pose it was picked in, and let go
+    (resting on the table with the gripper open)?"""
     xy_error = float(np.linalg.norm(X_WO_now.translation()[:2] - np.asarray(p_W_target_xy)))
     z_before = X_WO_picked.rotation().col(2)
     z_now = X_WO_now.rotation().col(2)
     tilt = float(np.arccos(np.clip(np.dot(z_before, z_now), -1.0, 1.0)))
     if not released:
-        return False, "still in the hand"
+        return False, "not let go: still held, or not resting on the table"
     if xy_error > PLACE_XY_TOLERANCE:
         return False, f"{xy_error * 100:.1f} cm from the place target"
     if tilt > PLACE_TILT_TOLERANCE:

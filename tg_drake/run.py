@@ -76,7 +76,6 @@ def run_scenario(scenario, *, scenario_path: str = "", meshcat=None, images_dir:
     from pydrake.systems.framework import DiagramBuilder
 
     from tg_drake.diagram import add_pipeline
-    from tg_drake.outcome import hand_contact, placed
 
     timings: dict[str, float] = {}
     t_start = time.perf_counter()
@@ -152,7 +151,7 @@ def run_scenario(scenario, *, scenario_path: str = "", meshcat=None, images_dir:
 
 def _execute(simulator, pipeline, scenario, result, timings, visualizer) -> Outcome:
     """Simulates planning and execution; reads off what physically happened."""
-    from tg_drake.outcome import hand_contact, placed
+    from tg_drake.outcome import hand_contact, placed, touches_table
 
     context = simulator.get_mutable_context()
     station = pipeline.station
@@ -217,9 +216,13 @@ def _execute(simulator, pipeline, scenario, result, timings, visualizer) -> Outc
         X_WO_now = body.EvalPoseInWorld(plant_context)
         if not np.all(np.isfinite(X_WO_now.GetAsMatrix4())):
             return Outcome("failed", "simulation", "the simulation diverged", **common)
+        # Let go: the gripper has opened and the table carries the object (a pad may still
+        # brush it after opening).
         release = hand_contact(plant, plant_context, object_body=body, wsg_instance=wsg)
+        on_table = touches_table(plant, plant_context, object_body=body,
+                                 table_instance=station.instances["table"])
         ok, detail = placed(X_WO_picked, X_WO_now, plan.X_WO_place[:2, 3],
-                            released=not (release.left or release.right))
+                            released=on_table and not release.held)
         if ok:
             return Outcome("placed", "", detail, **common)
         return Outcome("lifted", "slipped", detail, **common)
