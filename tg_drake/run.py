@@ -91,7 +91,8 @@ def run_scenario(scenario, *, scenario_path: str = "", meshcat=None, images_dir:
     context = simulator.get_mutable_context()
     timings["build"] = time.perf_counter() - t_start
 
-    result: dict = {"scenario": scenario_path, "task_given": scenario.task.task or None}
+    result: dict = {"scenario": scenario_path, "task_given": scenario.task.task or None,
+                    "perception": {"n_objects": 0, "target": None}}
 
     # The stages at t = 0, each timed on its own (their values stay cached for the planner).
     def timed(name, port):
