@@ -1,7 +1,7 @@
 """A scripted grasp-and-lift in the station, with no perception or reasoning.
 
 Used by the station tests (does the WSG hold a can / a cup body?) and by `tg-drake bench` for the
-`sim_rtf` figure. The gripper approaches the object's side horizontally from the robot's side,
+`sim_rtf` figure. The gripper approaches the object's side from the robot's side, tilted 30° down,
 closes across the object at a chosen height, and the arm lifts it.
 """
 
@@ -20,10 +20,9 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from tg_drake.errors import PlanningError
 from tg_drake.planning.ik import make_arm_plant, solve_ik
+from tg_drake.planning.planner import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.scenario import IIWA_HOME, Scenario
 from tg_drake.station import add_station, rotation_from_axes
-
-from tg_drake.planning.planner import GRASP_DEPTH  # noqa: E402  [m] grasp point along +y_G
 
 
 @dataclass
@@ -118,13 +117,11 @@ def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: flo
     opening = float(q_wsg[1] - q_wsg[0])
     contact: ContactResults = plant.get_contact_results_output_port().Eval(plant_context)
     surfaces = 0
-    inspector = station.scene_graph.model_inspector()
     object_geometries = set(plant.GetCollisionGeometriesForBody(body))
     for i in range(contact.num_hydroelastic_contacts()):
         s = contact.hydroelastic_contact_info(i).contact_surface()
         if s.id_M() in object_geometries or s.id_N() in object_geometries:
             surfaces += 1
-    del inspector
     object_rise = X_WO.translation()[2] - z_obj_grasp
     gripper_rise = G.CalcPoseInWorld(plant_context).translation()[2] - z_g_grasp
     held = bool(object_rise > 0.8 * gripper_rise and opening > 0.005)
