@@ -24,6 +24,7 @@ FIGURES: dict[str, str] = {
     "logic_scene_ms": "tg_drake.logic.bench:logic_scene_ms",
     "perception_ms": "tg_drake.perception.bench:perception_ms",
     "segmentation_ms": "tg_drake.perception.bench:segmentation_ms",
+    "dgi_us_per_hypothesis": "tg_drake.grasping.bench:dgi_us_per_hypothesis",
 }
 
 
