@@ -5,9 +5,12 @@ import pytest
 from pydrake.systems.framework import DiagramBuilder
 
 from tg_drake.errors import GraspingError
+from tg_drake.grasping.dataset import part_boxes, scene_cloud
 from tg_drake.grasping.dgi import GRIPPER_BASE_Y, PAD_CENTER_Y, dgi_features
+from tg_drake.grasping.hypotheses import box_grasps
 from tg_drake.grasping.model import DgiGraspModel, load_model
 from tg_drake.grasping.svm import PlattSvmClassifier
+from tg_drake.objects import get_object, sample_surface
 from tg_drake.systems.dgi_system import DgiScoringSystem
 from tg_drake.types import (
     GraspCandidates,
@@ -135,3 +138,22 @@ def test_model_file_round_trip(model, tmp_path):
                                   model.classifier.predict_proba(X))
     with pytest.raises(GraspingError, match="no DGI model file"):
         load_model(tmp_path / "missing.joblib")
+
+
+def test_the_shipped_model_scores_side_grasps_of_a_glass_above_an_empty_volume():
+    system = DgiScoringSystem()  # loads tg_drake/data/dgi_svm.joblib
+    model = system.model
+    assert model.info["n_grasps"] >= 5000
+    glass = get_object("glass_01")  # 6.8 cm across: fits the 11 cm opening
+    p_W, _, _ = scene_cloud(glass, "upright", seed=0)
+    p_O, _, labels = sample_surface(glass, spacing=0.003, rng=np.random.default_rng(0))
+    X_OB, half = part_boxes(p_O, labels)[part_index("middle")]
+    X_WG = box_grasps(glass.resting_pose("upright").X_TO @ X_OB, half)
+    # From the four sides, closing horizontally across the glass (faces ±x, ±y; closing along the
+    # other horizontal axis): the grasps that held in the training scenes.
+    side = X_WG[[0, 2, 5, 7]]
+    assert np.all(np.abs(side[:, 2, 0]) < 1e-9)  # closing axis horizontal
+    far = np.eye(4)
+    far[:3, 3] = [1.0, 1.0, 1.0]  # nothing in the volume
+    p = model.p_grasp(p_W, np.concatenate([side, far[None]]))
+    assert np.all(p[:4] > 0.5) and p[4] < 0.5

@@ -132,8 +132,12 @@ def points_in_gripper_frame(p_W: np.ndarray, X_WG: np.ndarray) -> np.ndarray:
     p_W, X_WG = _check_inputs(p_W, X_WG)
     R_WG = X_WG[:, :3, :3]
     p_WG = X_WG[:, :3, 3]
-    # p_G[m, n, j] = Σ_i R_WG[m, i, j] (p_W[n, i] − p_WG[m, i]).
-    return np.einsum("nI,mIj->mnj", p_W, R_WG) - np.einsum("mI,mIj->mj", p_WG, R_WG)[:, None, :]
+    # p_G[m, n, j] = Σ_i (p_W[n, i] − p_WG[m, i]) R_WG[m, i, j]: one matrix product for all poses
+    # (N × 3 by 3 × 3M), computed point-major and returned as an (M, N, 3) view.
+    M = len(X_WG)
+    p_G = (p_W @ R_WG.transpose(1, 0, 2).reshape(3, 3 * M)).reshape(len(p_W), M, 3)
+    p_G -= np.einsum("mi,mij->mj", p_WG, R_WG)[None]
+    return p_G.transpose(1, 0, 2)
 
 
 def closing_volume_mask(p_G: np.ndarray, config: DgiConfig = DgiConfig()) -> np.ndarray:
@@ -155,11 +159,11 @@ def depth_images(p_W: np.ndarray, X_WG: np.ndarray, config: DgiConfig = DgiConfi
     Pixel u runs along +x_G, pixel v along +z_G; depth = y_G − base_y ∈ [−palm_margin,
     depth_range).
     """
-    p_G = points_in_gripper_frame(p_W, X_WG)
-    M = p_G.shape[0]
+    p_G = points_in_gripper_frame(p_W, X_WG).transpose(1, 0, 2)  # (N, M, 3), contiguous
+    M = p_G.shape[1]
     inside = closing_volume_mask(p_G, config)
-    m_idx, n_idx = np.nonzero(inside)
-    q = p_G[m_idx, n_idx]
+    n_idx, m_idx = np.nonzero(inside)
+    q = p_G[n_idx, m_idx]
     u = np.floor((q[:, CLOSING_AXIS] + config.half_extent_x) / config.cell_size).astype(np.intp)
     v = np.floor((q[:, PAD_WIDTH_AXIS] + config.half_extent_z) / config.cell_size).astype(np.intp)
     # Rounding at the far boundary can give n_u (or n_v) for a point just inside; clip it back.
