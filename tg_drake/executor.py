@@ -143,7 +143,7 @@ class LocalExecutor(Executor):
 class RayExecutor(Executor):
     """Jobs as Ray tasks on a cluster (`address`, e.g. "auto") or a local Ray instance (None)."""
 
-    def __init__(self, address: str | None = None, *, max_in_flight: int = 1000):
+    def __init__(self, address: str | None = None, *, max_in_flight: int | None = None):
         try:
             import ray
         except ImportError:
@@ -152,7 +152,7 @@ class RayExecutor(Executor):
                 "pip install 'tg_drake[ray]'") from None
         self._ray = ray
         self.address = address
-        self.max_in_flight = max_in_flight
+        self.max_in_flight = max_in_flight or 1000  # tasks submitted and not yet finished
 
     def imap_unordered(self, fn, jobs):
         ray = self._ray
@@ -177,11 +177,14 @@ class RayExecutor(Executor):
 
 def make_executor(kind: str = "local", *, workers: int | None = None,
                   address: str | None = None) -> Executor:
-    """The executor named `kind` ("local" or "ray")."""
+    """The executor named `kind`: "local" (`workers` processes, default one per core) or "ray"
+    (the cluster at `address`, or a local Ray; at most `workers` jobs in flight, if given)."""
     if kind == "local":
+        if address is not None:
+            raise TgDrakeError(f"an address ({address!r}) is for the ray executor, not local")
         return LocalExecutor(workers)
     if kind == "ray":
-        return RayExecutor(address)
+        return RayExecutor(address, max_in_flight=workers)
     raise unknown_name("executor", kind, EXECUTORS, error=TgDrakeError)
 
 

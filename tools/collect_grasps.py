@@ -86,7 +86,8 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=Path("data/dgi/grasps.jsonl"))
     parser.add_argument("--objects", help="comma-separated object ids (default: the library)")
     parser.add_argument("--executor", choices=EXECUTORS, default="local")
-    parser.add_argument("--workers", type=int, default=1, help="local processes (0: in-process)")
+    parser.add_argument("--workers", type=int, default=1,
+                        help="local processes (0: in this process); with ray: jobs in flight")
     parser.add_argument("--address", help="Ray cluster address (with --executor ray)")
     parser.add_argument("--batch", type=int, default=20, help="grasps per job")
     parser.add_argument("--seed", type=int, default=0)

@@ -89,6 +89,8 @@ def test_a_torn_last_line_is_ignored_and_rerun(tmp_path):
 def test_bad_executor_requests_are_clear_errors():
     with pytest.raises(TgDrakeError, match="unknown executor 'dask'; allowed: local, ray"):
         make_executor("dask")
+    with pytest.raises(TgDrakeError, match="is for the ray executor"):
+        make_executor("local", address="auto")
     with pytest.raises(TgDrakeError, match="job keys must be unique"):
         run_jobs(square, [Job("a", [1]), Job("a", [2])], out=None, executor=None)
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tg_drake.grasping.dgi import FINGERTIP_Y, PAD_CENTER_Y
-from tg_drake.grasping.episode import EpisodeConfig, GraspWorld
+from tg_drake.grasping.episode import EpisodeConfig, GraspWorld, scripted_targets
 
 CYLINDER_SDF = """<?xml version="1.0"?>
 <sdf version="1.9" xmlns:drake="http://drake.mit.edu">
@@ -99,3 +99,25 @@ def test_a_physics_failure_is_reported_not_raised(world):
     # The world is reusable after a failure.
     again = world.run(X_WO, top_down([0, 0, HEIGHT + 0.01]))
     assert again["status"] == "ok" and again["success"]
+
+
+def test_the_script_approaches_closes_lifts_and_shakes_back_to_rest():
+    c = EpisodeConfig()
+    R_GW = top_down([0, 0, 0])[:3, :3].T
+    at = {t: scripted_targets(t, c, R_GW) for t in (
+        0.0, c.approach_time, c.approach_time + c.close_time,
+        c.approach_time + c.close_time + c.lift_time, c.duration)}
+    t0, t1, t2, t3, t4 = at.values()
+    assert t0["carrier_y"] == (-c.approach_distance, 0.0)
+    assert t0["right_finger_sliding_joint"][0] == pytest.approx(0.055)
+    assert t1["carrier_y"] == (0.0, 0.0)
+    # Past the centre by grip_force / kp: 60 N / 2000 N/m = 3 cm.
+    assert t2["right_finger_sliding_joint"][0] == pytest.approx(-0.03)
+    assert t2["left_finger_sliding_joint"][0] == pytest.approx(0.03)
+    # Up 0.1 m along z_W, which is −y_G for a top-down grasp.
+    for t in (t3, t4):
+        assert t["carrier_y"][0] == pytest.approx(-c.lift_height, abs=1e-12)
+        assert t["carrier_x"][0] == pytest.approx(0.0, abs=1e-12)
+        assert t["carrier_rz"] == (0.0, 0.0)
+        # Desired velocities are zero at rest (1e-12: rounding of the sin² envelope).
+        assert all(abs(qv[1]) < 1e-12 for qv in t.values())

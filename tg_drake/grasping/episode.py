@@ -97,81 +97,83 @@ def _smoothstep(s):
     return 3 * s**2 - 2 * s**3, 6 * s * (1 - s)
 
 
-class GraspScript(LeafSystem):
-    """Desired state of the gripper's eight actuated joints over an episode.
+def scripted_targets(t: float, config: EpisodeConfig, R_GW: np.ndarray) -> dict:
+    """Joint name → (desired position, desired velocity) of the eight actuated joints at time t.
 
+    R_GW expresses the world-frame lift and shake in the grasp frame F = G₀.
+    """
+    c = config
+    # 1. approach along +y_G.
+    s, ds = _smoothstep(t / c.approach_time)
+    p_G = np.array([0.0, -c.approach_distance * (1 - s), 0.0])
+    v_G = np.array([0.0, c.approach_distance * ds / c.approach_time, 0.0])
+    # 2. close: from fully open to past the centre by grip_force / kp.
+    t_close = t - c.approach_time
+    s, ds = _smoothstep(t_close / c.close_time)
+    open_q = MAX_OPENING / 2
+    closed_q = -c.grip_force / c.finger_kp
+    finger_q = open_q + (closed_q - open_q) * s
+    finger_v = (closed_q - open_q) * ds / c.close_time
+    # 3. lift along +z_W.
+    t_lift = t_close - c.close_time
+    s, ds = _smoothstep(t_lift / c.lift_time)
+    p_W = np.array([0.0, 0.0, c.lift_height * s])
+    v_W = np.array([0.0, 0.0, c.lift_height * ds / c.lift_time])
+    # 4. shake: a horizontal circle and a rotation about z_G, under a sin² envelope.
+    t_shake = t_lift - c.lift_time
+    angle = rate = 0.0
+    if 0.0 < t_shake < c.shake_time:
+        omega = 2 * np.pi * c.shake_cycles / c.shake_time
+        env = np.sin(np.pi * t_shake / c.shake_time) ** 2
+        denv = np.pi / c.shake_time * np.sin(2 * np.pi * t_shake / c.shake_time)
+        ring = np.array([np.sin(omega * t_shake), 1 - np.cos(omega * t_shake), 0.0])
+        dring = omega * np.array([np.cos(omega * t_shake), np.sin(omega * t_shake), 0.0])
+        p_W += c.shake_amplitude * env * ring
+        v_W += c.shake_amplitude * (denv * ring + env * dring)
+        angle = c.shake_angle * env * np.sin(omega * t_shake)
+        rate = c.shake_angle * (denv * np.sin(omega * t_shake)
+                                + env * omega * np.cos(omega * t_shake))
+    p_G = p_G + R_GW @ p_W
+    v_G = v_G + R_GW @ v_W
+    targets = {name: (p_G[axis], v_G[axis]) for axis, name in enumerate(CARRIER_JOINTS[:3])}
+    targets.update(carrier_rx=(0.0, 0.0), carrier_ry=(0.0, 0.0), carrier_rz=(angle, rate))
+    # The left finger moves along −x (its joint runs from −0.055 open to 0 closed).
+    targets[FINGER_JOINTS[0]] = (-finger_q, -finger_v)
+    targets[FINGER_JOINTS[1]] = (finger_q, finger_v)
+    return targets
+
+
+class GraspScript(LeafSystem):
+    """
     .. pydrake_system::
 
         name: GraspScript
         output_ports:
         - desired_state
 
-    Numeric parameter: R_GW (9 entries, row-major), to express world-frame lift and shake in the
-    grasp frame F = G₀. Output order is the plant's actuator order, given as `actuator_joints`.
+    The desired state of the gripper's eight actuated joints over an episode
+    (`scripted_targets`), in the plant's actuator order, given as `actuator_joints`. Numeric
+    parameter: R_GW (9 entries, row-major) of the episode's grasp pose.
     """
 
     def __init__(self, config: EpisodeConfig, actuator_joints: list[str]):
         super().__init__()
         self._config = config
-        self._index = {name: i for i, name in enumerate(actuator_joints)}
-        self._n = len(actuator_joints)
+        self._joints = list(actuator_joints)
         self._R_GW_index = self.DeclareNumericParameter(BasicVector(np.eye(3).ravel()))
         self._desired_state = self.DeclareVectorOutputPort(
-            "desired_state", 2 * self._n, self._calc_desired_state)
+            "desired_state", 2 * len(self._joints), self._calc_desired_state)
+
+    def get_desired_state_output_port(self):
+        return self._desired_state
 
     def set_grasp_orientation(self, context, R_WG: np.ndarray) -> None:
         context.get_mutable_numeric_parameter(self._R_GW_index).SetFromVector(R_WG.T.ravel())
 
     def _calc_desired_state(self, context, output):
-        c = self._config
-        t = context.get_time()
         R_GW = context.get_numeric_parameter(self._R_GW_index).value().reshape(3, 3)
-        q = np.zeros(self._n)
-        v = np.zeros(self._n)
-
-        # 1. approach along +y_G.
-        s, ds = _smoothstep(t / c.approach_time)
-        p_G = np.array([0.0, -c.approach_distance * (1 - s), 0.0])
-        v_G = np.array([0.0, c.approach_distance * ds / c.approach_time, 0.0])
-        # 2. close: from fully open to past the centre by grip_force / kp.
-        t_close = t - c.approach_time
-        s, ds = _smoothstep(t_close / c.close_time)
-        open_q = MAX_OPENING / 2
-        closed_q = -c.grip_force / c.finger_kp
-        finger_q = open_q + (closed_q - open_q) * s
-        finger_v = (closed_q - open_q) * ds / c.close_time
-        # 3. lift along +z_W.
-        t_lift = t_close - c.close_time
-        s, ds = _smoothstep(t_lift / c.lift_time)
-        p_W = np.array([0.0, 0.0, c.lift_height * s])
-        v_W = np.array([0.0, 0.0, c.lift_height * ds / c.lift_time])
-        # 4. shake: a horizontal circle and a rotation about z_G, under a sin² envelope.
-        t_shake = t_lift - c.lift_time
-        angle = 0.0
-        rate = 0.0
-        if 0.0 < t_shake < c.shake_time:
-            omega = 2 * np.pi * c.shake_cycles / c.shake_time
-            env = np.sin(np.pi * t_shake / c.shake_time) ** 2
-            denv = np.pi / c.shake_time * np.sin(2 * np.pi * t_shake / c.shake_time)
-            ring = np.array([np.sin(omega * t_shake), 1 - np.cos(omega * t_shake), 0.0])
-            dring = omega * np.array([np.cos(omega * t_shake), np.sin(omega * t_shake), 0.0])
-            p_W += c.shake_amplitude * env * ring
-            v_W += c.shake_amplitude * (denv * ring + env * dring)
-            angle = c.shake_angle * env * np.sin(omega * t_shake)
-            rate = c.shake_angle * (denv * np.sin(omega * t_shake)
-                                    + env * omega * np.cos(omega * t_shake))
-        p_G = p_G + R_GW @ p_W
-        v_G = v_G + R_GW @ v_W
-        for axis, name in enumerate(CARRIER_JOINTS[:3]):
-            q[self._index[name]] = p_G[axis]
-            v[self._index[name]] = v_G[axis]
-        q[self._index["carrier_rz"]] = angle
-        v[self._index["carrier_rz"]] = rate
-        # Left finger moves along −x (its joint runs from −0.055 open to 0 closed).
-        q[self._index[FINGER_JOINTS[0]]] = -finger_q
-        v[self._index[FINGER_JOINTS[0]]] = -finger_v
-        q[self._index[FINGER_JOINTS[1]]] = finger_q
-        v[self._index[FINGER_JOINTS[1]]] = finger_v
+        targets = scripted_targets(context.get_time(), self._config, R_GW)
+        q, v = zip(*(targets[name] for name in self._joints))
         output.SetFromVector(np.concatenate([q, v]))
 
 
@@ -231,7 +233,8 @@ class GraspWorld:
         actuator_joints = [plant.get_joint_actuator(i).joint().name()
                            for i in plant.GetJointActuatorIndices(wsg)]
         script = builder.AddSystem(GraspScript(config, actuator_joints))
-        builder.Connect(script.get_output_port(), plant.get_desired_state_input_port(wsg))
+        builder.Connect(script.get_desired_state_output_port(),
+                        plant.get_desired_state_input_port(wsg))
         self.diagram = builder.Build()
         self.plant = plant
         self.script = script

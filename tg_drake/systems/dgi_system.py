@@ -12,8 +12,7 @@ from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 
 class DgiScoringSystem(LeafSystem):
-    """Scores the target object's pre-grasp hypotheses by part and local shape.
-
+    """
     .. pydrake_system::
 
         name: DgiScoringSystem
@@ -23,7 +22,7 @@ class DgiScoringSystem(LeafSystem):
         output_ports:
         - ranked_grasps
 
-    For the object that ``grasp_semantics`` (a `GraspSemantics`) is about, every pre-grasp
+    Scores the target object's pre-grasp hypotheses by part and local shape. For the object that ``grasp_semantics`` (a `GraspSemantics`) is about, every pre-grasp
     hypothesis of ``scene_description`` (a `SceneDescription`) gets P(grasp | local shape) from
     the DGI features of the object's cloud in the WSG's closing volume and the RBF SVM + Platt
     sigmoid, and the logic's P(part | task) of its part. ``ranked_grasps`` (a `GraspCandidates`)
