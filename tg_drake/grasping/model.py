@@ -14,6 +14,7 @@ from pathlib import Path
 
 import joblib
 import numpy as np
+from threadpoolctl import ThreadpoolController
 
 from tg_drake.errors import GraspingError
 from tg_drake.grasping.dgi import DgiConfig, dgi_features
@@ -43,8 +44,14 @@ class DgiGraspModel:
         return dgi_features(p_W, X_WG, self.config)
 
     def p_grasp(self, p_W: np.ndarray, X_WG: np.ndarray) -> np.ndarray:
-        """(M,) P(grasp | local shape) of the cloud `p_W` for each gripper pose X_WG (M, 4, 4)."""
-        return self.classifier.predict_proba(self.features(p_W, X_WG))[:, 1]
+        """(M,) P(grasp | local shape) of the cloud `p_W` for each gripper pose X_WG (M, 4, 4).
+
+        BLAS runs on one thread here: the matrix products are small, and on a loaded machine
+        (a simulator beside us, other processes) OpenBLAS threads wait on each other — measured
+        4× slower with two threads than with one on our shared 2-core machine.
+        """
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            return self.classifier.predict_proba(self.features(p_W, X_WG))[:, 1]
 
     def save(self, path: Path) -> None:
         path = Path(path)
@@ -62,6 +69,12 @@ def load_model(path: str | Path) -> DgiGraspModel:
     if not isinstance(data, dict) or data.get("format") != FORMAT_VERSION:
         raise GraspingError(f"not a DGI model file of format {FORMAT_VERSION}", file=str(path))
     return DgiGraspModel(data["classifier"], DgiConfig(**data["config"]), data["info"])
+
+
+@functools.cache
+def _blas_controller() -> ThreadpoolController:
+    """Inspects the loaded thread pools once; limiting them through it is then cheap."""
+    return ThreadpoolController()
 
 
 @functools.cache
