@@ -388,3 +388,29 @@ def main(args) -> int:
         except KeyboardInterrupt:
             pass
     return 0 if result["outcome"]["status"] != "failed" else 1
+
+
+def bench_pipeline_rtf():
+    """`pipeline_rtf`: simulated seconds per wall second of the default scenario's whole
+    pick-and-place (render, perception, prior, logic, scoring, planning and the simulated execution;
+    the one-off diagram build is not counted), median of 3 runs. The reference is the same run with
+    Drake's explicit inverse-dynamics arm controller at a 2 ms step (one run); `speedup` = ours /
+    reference (a rate: higher is better)."""
+    from tg_drake.bench import Figure
+    from tg_drake.scenario import InverseDynamicsDriver, ObjectPlacement, Scenario, TaskConfig
+
+    def rate(explicit: bool) -> float:
+        # scenarios/default.yaml: the paper's Fig. 1 cup, upright and empty, to be passed.
+        scenario = Scenario(objects=[ObjectPlacement(id="cup_01", pose="upright")],
+                            task=TaskConfig(task="pass", place_xy=[0.0, -0.3]))
+        if explicit:
+            scenario.model_drivers["iiwa"] = InverseDynamicsDriver()
+            scenario.plant_config.time_step = 0.002
+        t = run_scenario(scenario, scenario_path="default")["timings"]
+        return t["simulated_time"] / (t["total"] - t["build"])
+
+    ours = sorted(rate(False) for _ in range(3))[1]
+    reference = rate(True)
+    return Figure(median=ours, unit="simulated s / wall s",
+                  reference="explicit InverseDynamicsController, 2 ms step, same scenario",
+                  reference_median=reference, speedup=ours / reference)
