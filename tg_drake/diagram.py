@@ -127,7 +127,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     builder.Connect(scene, logic.GetInputPort("scene_description"))
     builder.Connect(prior.GetOutputPort("category_prior"), logic.GetInputPort("category_prior"))
     builder.Connect(task.get_output_port(), logic.GetInputPort("task"))
-    scoring = builder.AddNamedSystem("dgi_scoring", DgiScoringSystem())
+    scoring = builder.AddNamedSystem(
+        "dgi_scoring", DgiScoringSystem(selection=config.grasp_selection))
     builder.Connect(scene, scoring.GetInputPort("scene_description"))
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     scoring.GetInputPort("grasp_semantics"))

@@ -181,6 +181,7 @@ class TaskConfig:
 
 
 PERCEPTION_MODES = ("depth", "ground_truth")
+GRASP_SELECTIONS = ("pipeline", "local_only")  # tg_drake.grasping.scoring.rank_grasps
 THEORY_VARIANTS = ("specific", "general")
 
 
@@ -200,6 +201,8 @@ class PipelineConfig:
     max_requeries: int = 3  # re-queries of the logic with collision(Part) evidence
     min_grasp_probability: float = 0.03  # below this P(some part is grasped | observations), the
     # logic is taken to rule grasping out (an upside-down pan: 0.015; the paper's Fig. 1 cup: 0.13)
+    grasp_selection: str = "pipeline"  # how hypotheses are ranked: "pipeline" (P(part | task) ·
+    # P(grasp | local shape)) or "local_only" (P(grasp | local shape) alone, the paper's Local)
 
     def validate(self, where: str = "pipeline") -> None:
         if self.perception not in PERCEPTION_MODES:
@@ -209,6 +212,9 @@ class PipelineConfig:
             if getattr(self, name) not in THEORY_VARIANTS:
                 raise unknown_name("theory variant", getattr(self, name), THEORY_VARIANTS,
                                    error=ScenarioError, field=f"{where}.{name}")
+        if self.grasp_selection not in GRASP_SELECTIONS:
+            raise unknown_name("grasp selection", self.grasp_selection, GRASP_SELECTIONS,
+                               error=ScenarioError, field=f"{where}.grasp_selection")
 
 
 @dataclass

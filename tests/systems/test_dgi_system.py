@@ -157,3 +157,22 @@ def test_the_shipped_model_scores_side_grasps_of_a_glass_above_an_empty_volume()
     far[:3, 3] = [1.0, 1.0, 1.0]  # nothing in the volume
     p = model.p_grasp(p_W, np.concatenate([side, far[None]]))
     assert np.all(p[:4] > 0.5) and p[4] < 0.5
+
+
+def test_local_only_ranks_by_local_shape_alone_and_names_bad_selections(model):
+    builder = DiagramBuilder()
+    system = builder.AddSystem(DgiScoringSystem(model, selection="local_only"))
+    diagram = builder.Build()
+    poses = np.stack([top_down([0.62, 0, 0.09]), top_down([0.5, 0, 0.09])])
+    parts = [part_index("top"), part_index("handle")]  # the logic gives the graspable one 0
+    scene = SceneDescription(objects=[cylinder_object(poses, parts)], X_WT=np.eye(4), target=0)
+    semantics = GraspSemantics(category={"cup": 1.0}, task={"pass": 1.0}, part={"top": 1.0},
+                               given_task="pass")
+    ranked = evaluate(system, diagram, scene, semantics)
+    p_local = model.p_grasp(scene.objects[0].p_W, poses)
+    assert p_local[1] > 0.5 > p_local[0]
+    np.testing.assert_array_equal(ranked.parts, [part_index("handle"), part_index("top")])
+    np.testing.assert_allclose(ranked.score, p_local[[1, 0]], atol=1e-12)
+    np.testing.assert_allclose(ranked.p_part, [0.0, 1.0])  # kept for the record
+    with pytest.raises(GraspingError, match="unknown grasp selection 'logic'; allowed: pipeline"):
+        DgiScoringSystem(model, selection="logic")

@@ -1,22 +1,30 @@
-"""The final grasp score: the logic's P(part | task) times the DGI's P(grasp | local shape)."""
+"""The final grasp score: the logic's P(part | task) times the DGI's P(grasp | local shape).
+
+`selection="local_only"` ranks by P(grasp | local shape) alone, ignoring the logic: the paper's
+Local baseline (section VI, Table "pipeline").
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from tg_drake.errors import GraspingError
+from tg_drake.errors import GraspingError, unknown_name
 from tg_drake.grasping.model import DgiGraspModel
 from tg_drake.types import PART_LABELS, GraspCandidates, GraspSemantics, SceneDescription
 
+SELECTIONS = ("pipeline", "local_only")  # how rank_grasps scores a hypothesis
+
 
 def rank_grasps(scene: SceneDescription, semantics: GraspSemantics,
-                model: DgiGraspModel) -> GraspCandidates:
+                model: DgiGraspModel, *, selection: str = "pipeline") -> GraspCandidates:
     """Every pre-grasp hypothesis of the target object, scored and sorted best first.
 
     p_local = P(grasp | local shape) from the DGI model, p_part = the logic's P(part | task) of the
-    hypothesis' part (0 for a part the logic did not name), score = p_part · p_local. Ties keep the
-    hypotheses' order.
+    hypothesis' part (0 for a part the logic did not name), score = p_part · p_local
+    (`selection="pipeline"`) or p_local alone (`"local_only"`). Ties keep the hypotheses' order.
     """
+    if selection not in SELECTIONS:
+        raise unknown_name("grasp selection", selection, SELECTIONS, error=GraspingError)
     target = semantics.target
     if not 0 <= target < len(scene.objects):
         raise GraspingError(
@@ -37,7 +45,7 @@ def rank_grasps(scene: SceneDescription, semantics: GraspSemantics,
         return GraspCandidates(np.zeros((0, 4, 4)), parts, empty, empty, empty, target)
     p_local = model.p_grasp(obj.p_W, X_WG)
     p_part = np.array([semantics.part.get(PART_LABELS[k], 0.0) for k in parts], dtype=float)
-    score = p_part * p_local
+    score = p_part * p_local if selection == "pipeline" else p_local
     order = np.argsort(-score, kind="stable")
     return GraspCandidates(X_WG[order], parts[order], p_part[order], p_local[order], score[order],
                            target)

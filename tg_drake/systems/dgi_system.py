@@ -6,8 +6,9 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
+from tg_drake.errors import GraspingError, unknown_name
 from tg_drake.grasping.model import DgiGraspModel, load_default_model
-from tg_drake.grasping.scoring import rank_grasps
+from tg_drake.grasping.scoring import SELECTIONS, rank_grasps
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 
@@ -28,11 +29,15 @@ class DgiScoringSystem(LeafSystem):
     sigmoid, and the logic's P(part | task) of its part. ``ranked_grasps`` (a `GraspCandidates`)
     holds them all with score = P(part | task) · P(grasp | local shape), best first.
 
-    The model is the one shipped with the package unless `model` is given.
+    The model is the one shipped with the package unless `model` is given. `selection`
+    "local_only" ranks by P(grasp | local shape) alone (the paper's Local baseline).
     """
 
-    def __init__(self, model: DgiGraspModel | None = None):
+    def __init__(self, model: DgiGraspModel | None = None, *, selection: str = "pipeline"):
         super().__init__()
+        if selection not in SELECTIONS:
+            raise unknown_name("grasp selection", selection, SELECTIONS, error=GraspingError)
+        self._selection = selection
         self._model = model if model is not None else load_default_model()
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description",
@@ -64,4 +69,5 @@ class DgiScoringSystem(LeafSystem):
 
     def _calc_ranked_grasps(self, context, output):
         output.set_value(rank_grasps(self._scene_port.Eval(context),
-                                     self._semantics_port.Eval(context), self._model))
+                                     self._semantics_port.Eval(context), self._model,
+                                     selection=self._selection))
