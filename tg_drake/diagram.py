@@ -138,7 +138,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     place_xy_W = (X_WT @ np.array([*scenario.task.place_xy, 0.0, 1.0]))[:2]
     planner = builder.AddNamedSystem("planner", GraspPlanner(
         place_xy=place_xy_W, start_time=config.planning_start,
-        max_requeries=config.max_requeries, scenario=scenario))
+        max_requeries=config.max_requeries, scenario=scenario, grasp_part=config.grasp_part))
     builder.Connect(scene, planner.GetInputPort("scene_description"))
     builder.Connect(scoring.GetOutputPort("ranked_grasps"), planner.GetInputPort("ranked_grasps"))
     builder.Connect(station.outputs["iiwa.state"], planner.GetInputPort("iiwa.state"))

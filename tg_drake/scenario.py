@@ -30,7 +30,7 @@ from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.sensors import CameraConfig
 
 from tg_drake.errors import ScenarioError, unknown_name
-from tg_drake.types import CONTAINMENTS, POSES, TASKS
+from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 # Where the table-top frame T sits in the world (its surface at the iiwa base height). Its centre
 # is 0.75 m in front of the base: side grasps at 0.7–0.9 m and top grasps at 0.45–0.8 m are within
@@ -182,7 +182,7 @@ class TaskConfig:
 
 PERCEPTION_MODES = ("depth", "ground_truth")
 GRASP_SELECTIONS = ("pipeline", "local_only")  # tg_drake.grasping.scoring.rank_grasps
-THEORY_VARIANTS = ("specific", "general")
+THEORY_VARIANTS = ("specific", "general", "learned")  # "learned": tools/learn_theory.py
 
 
 @dataclass
@@ -203,6 +203,8 @@ class PipelineConfig:
     # logic is taken to rule grasping out (an upside-down pan: 0.015; the paper's Fig. 1 cup: 0.13)
     grasp_selection: str = "pipeline"  # how hypotheses are ranked: "pipeline" (P(part | task) ·
     # P(grasp | local shape)) or "local_only" (P(grasp | local shape) alone, the paper's Local)
+    grasp_part: str | None = None  # only hypotheses of this PART_LABELS part are tried, ranked by
+    # the DGI's P(grasp | shape) alone (the logic may give the part 0): for data collection
 
     def validate(self, where: str = "pipeline") -> None:
         if self.perception not in PERCEPTION_MODES:
@@ -215,6 +217,9 @@ class PipelineConfig:
         if self.grasp_selection not in GRASP_SELECTIONS:
             raise unknown_name("grasp selection", self.grasp_selection, GRASP_SELECTIONS,
                                error=ScenarioError, field=f"{where}.grasp_selection")
+        if self.grasp_part is not None and self.grasp_part not in PART_LABELS:
+            raise unknown_name("part", self.grasp_part, PART_LABELS, error=ScenarioError,
+                               field=f"{where}.grasp_part")
 
 
 @dataclass

@@ -17,9 +17,10 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
+from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.planning.planner import Plan, PlannerConfig, PlanResult, plan_for_scene
 from tg_drake.scenario import IIWA_HOME, Scenario
-from tg_drake.types import GraspCandidates, SceneDescription
+from tg_drake.types import PART_LABELS, GraspCandidates, SceneDescription
 
 
 @dataclass(frozen=True)
@@ -96,7 +97,7 @@ class GraspPlanner(LeafSystem):
 
     def __init__(self, *, place_xy, start_time: float = 0.0, period: float = 0.05,
                  max_requeries: int = 3, config: PlannerConfig | None = None,
-                 scenario: Scenario | None = None):
+                 scenario: Scenario | None = None, grasp_part: str | None = None):
         """
         Args:
             place_xy: (2,) world xy where the target object's frame origin is placed [m].
@@ -108,6 +109,9 @@ class GraspPlanner(LeafSystem):
             config: the planner's distances, clearances, timing and limits.
             scenario: whose robot and table models the planner's arm plant uses (default: the
                 station's).
+            grasp_part: only hypotheses of this part are tried, by the DGI's P(grasp | shape)
+                alone (`only_part`); None: all, by score. For data collection
+                (tools/learn_theory.py), so that outcomes exist for parts the logic would not pick.
         """
         super().__init__()
         if len(place_xy) != 2:
@@ -118,6 +122,10 @@ class GraspPlanner(LeafSystem):
         self._max_requeries = int(max_requeries)
         self._config = config or PlannerConfig()
         self._scenario = scenario
+        if grasp_part is not None and grasp_part not in PART_LABELS:
+            raise unknown_name("part", grasp_part, PART_LABELS, error=ScenarioError,
+                               field="grasp_part")
+        self._grasp_part = grasp_part
 
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
@@ -178,6 +186,8 @@ class GraspPlanner(LeafSystem):
             return EventStatus.DidNothing()
         scene: SceneDescription = self._scene_port.Eval(context)
         grasps: GraspCandidates = self._grasps_port.Eval(context)
+        if self._grasp_part is not None:
+            grasps = only_part(grasps, self._grasp_part)
         t0 = time.perf_counter()
         if len(grasps.score) == 0 or not scene.objects:
             memory = dataclasses.replace(
@@ -245,6 +255,16 @@ class GraspPlanner(LeafSystem):
         output.set_value(PlanStatus("done" if done else "executing", part=plan.part,
                                     candidate=plan.candidate, X_WG=plan.X_WG_grasp,
                                     t_plan=memory.t_plan, plan=plan, **common))
+
+
+def only_part(grasps: GraspCandidates, part: str) -> GraspCandidates:
+    """The candidates with the score of every hypothesis of another part set to 0 (ruled out) and
+    that of `part`'s hypotheses set to P(grasp | shape): the logic's P(part | task) is the same
+    for all hypotheses of a part, so their order is kept, and a part the logic gives 0 is still
+    tried. Indices are unchanged (the plan's `candidate` indexes ``ranked_grasps``)."""
+    mine = np.asarray(grasps.parts) == PART_LABELS.index(part)
+    score = np.where(mine, np.asarray(grasps.p_local, float), 0.0)
+    return dataclasses.replace(grasps, score=score)
 
 
 def _no_candidates() -> GraspCandidates:
