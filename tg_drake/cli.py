@@ -21,6 +21,7 @@ COMMANDS: dict[str, str] = {
     "objects": "tg_drake.objects",
     "render": "tg_drake.render",
     "run": "tg_drake.run",
+    "eval": "tg_drake.evaluation.cli",
 }
 
 

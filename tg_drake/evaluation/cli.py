@@ -1,0 +1,126 @@
+"""`tg-drake eval SUITE... --out DIR`: run suites, stream their records, write the paper's tables.
+
+    tg-drake eval scenarios/suites/s_syn.yaml --out out/eval
+    tg-drake eval scenarios/suites/*.yaml --out out/eval --executor ray --address auto
+
+Writes, in DIR: `results.jsonl` (one line per case as it finishes — perceived cases one per
+setting; a rerun skips finished cases; a crashed case is recorded as an error and counts as a
+failure), then `tables.json`, `tables.md` and PNG plots derived from every record of the suites
+given. `--tables-only` derives the tables from the records already there.
+"""
+
+from __future__ import annotations
+
+import json
+import shlex
+import sys
+from pathlib import Path
+
+HELP = "run evaluation suites (progress bar, resumable results.jsonl) and write the paper's tables"
+
+
+def add_arguments(parser) -> None:
+    from tg_drake.executor import EXECUTORS
+
+    parser.add_argument("suites", type=Path, nargs="+", metavar="SUITE",
+                        help="suite YAML files (scenarios/suites/)")
+    parser.add_argument("--out", type=Path, required=True, help="output folder")
+    parser.add_argument("--executor", choices=EXECUTORS, default="local",
+                        help="local process pool (default) or a Ray cluster")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="worker processes (local; default one per core; 0 = in this process)"
+                             " or jobs in flight (ray)")
+    parser.add_argument("--address", default=None, help="Ray cluster address (e.g. auto)")
+    parser.add_argument("--retry-errors", action="store_true",
+                        help="run again the cases recorded as errors")
+    parser.add_argument("--tables-only", action="store_true",
+                        help="only derive the tables and plots from DIR/results.jsonl")
+
+
+def load_cases(paths) -> list:
+    """The cases of several suites, executed runs grouped by scenario (their variants side by
+    side, so that a sweep cut short still compares the variants on the scenarios it ran)."""
+    from tg_drake.errors import ScenarioError
+    from tg_drake.evaluation.suite import load_suite
+
+    cases = []
+    for path in paths:
+        cases += load_suite(path)[1]
+    keys = [c.key for c in cases]
+    if len(set(keys)) != len(keys):
+        dup = sorted({k for k in keys if keys.count(k) > 1})
+        raise ScenarioError(f"the same case in two suites (a suite given twice?): {dup[0]}")
+    order = {"synthetic": 0, "perceived": 1, "executed": 2}
+    return sorted(cases, key=lambda c: (order[c.kind], c.key.split("/", 1)[1].split("@")[0]
+                                        if c.kind == "executed" else ""))
+
+
+def read_records(out: Path, cases) -> list[dict]:
+    """The records of `cases` in results.jsonl; a case recorded as an error becomes a record with
+    its metadata and "error" (one per setting for a perceived case)."""
+    from tg_drake.evaluation.suite import DATASET_OF_SETTING
+
+    by_key = {c.key: c for c in cases}
+    records = []
+    if not out.exists():
+        return records
+    seen_error = set()
+    for line in out.read_text().splitlines():
+        try:
+            r = json.loads(line)
+        except json.JSONDecodeError:
+            continue  # a line cut by a killed run
+        case = by_key.get(r.get("job"))
+        if case is None:
+            continue
+        if r.get("status") == "error":
+            if case.key in seen_error:
+                continue
+            seen_error.add(case.key)
+            meta = case.meta()
+            for setting in case.settings or [None]:
+                records.append({"job": case.key, **meta, "error": r.get("reason", ""),
+                                **({"setting": setting, "dataset": DATASET_OF_SETTING[setting]}
+                                   if setting else {})})
+        else:
+            records.append(r)
+    return records
+
+
+def write_tables(out_dir: Path, records: list[dict], command: str, notes: str = "") -> dict:
+    from tg_drake.evaluation.plots import save_plots
+    from tg_drake.evaluation.tables import compute, markdown
+
+    tables = compute(records)
+    tables["command"] = command
+    (out_dir / "tables.json").write_text(json.dumps(tables, indent=1) + "\n")
+    (out_dir / "tables.md").write_text(markdown(tables, command=command, notes=notes))
+    save_plots(tables, out_dir)
+    return tables
+
+
+def main(args) -> int:
+    from tg_drake.executor import Job, make_executor, run_jobs
+
+    cases = load_cases(args.suites)
+    out = args.out / "results.jsonl"
+    if not args.tables_only:
+        executor = make_executor(args.executor, workers=args.workers, address=args.address)
+        summary = run_jobs(_run, [Job(c.key, c) for c in cases], out=out, executor=executor,
+                           retry_errors=args.retry_errors)
+        print(f"{summary.n_jobs} cases: {summary.n_skipped} already done, {summary.n_ran} run now "
+              f"({summary.n_errors} recorded as errors)", file=sys.stderr)
+    records = read_records(out, cases)
+    command = "tg-drake eval " + " ".join(shlex.quote(a) for a in sys.argv[2:]) \
+        if sys.argv[1:2] == ["eval"] else "tg-drake eval " + " ".join(map(str, args.suites))
+    tables = write_tables(args.out, records, command)
+    done = {r["job"] for r in records}
+    print(f"{len(done)} of {len(cases)} cases have records; tables in {args.out}/tables.md "
+          f"({tables['n_errors']} crashed cases counted as failures)")
+    return 0
+
+
+def _run(case):
+    from tg_drake.evaluation.jobs import run_case
+
+    return run_case(case)

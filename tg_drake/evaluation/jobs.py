@@ -1,0 +1,226 @@
+"""One case of a suite → one record (or one per setting): what each method answered.
+
+`run_case` is the function a sweep hands to the executor (module level, so that worker processes
+and Ray import it by name). It keeps raw answers — distributions, not verdicts — so that every
+table can be derived again from the records (tg_drake.evaluation.tables).
+
+- synthetic: observations from the labelled mesh (parts certain, pose certain, containment, handle
+  count); kernel priors at T = 0 (Label fractions) and T = kernel_T (Manifolds) from one labelled
+  sampling of the mesh, leave-one-object-out; then every logic method (METHODS) answers category,
+  task (inferred) and, for each ground-truth task given, the pre-grasp part.
+- perceived: the object's depth image ray cast from the default camera's viewpoint and perceived;
+  pose and part detection against the truth; then the same queries on observations of each setting.
+- executed: `tg_drake.run.run_scenario` on the scenario in the case's variant.
+"""
+
+from __future__ import annotations
+
+import functools
+import zlib
+
+import numpy as np
+
+from tg_drake.errors import PerceptionError, RuleError, TgDrakeError
+from tg_drake.types import CATEGORIES, TASKS
+
+# Logic methods (the paper's columns and the two ablations): name → (category/task theory,
+# pre-grasp theory, prior). Theories as (category model, grasp model, exclusive); the pre-grasp
+# columns keep the specific category model, as the paper's Table "pre-grasp" does.
+METHODS = {
+    "plm_uniform": (("specific", "specific", True), ("specific", "specific", True), "uniform"),
+    "plm_general_uniform": (("general", "general", True), ("specific", "general", True),
+                            "uniform"),
+    "plm": (("specific", "specific", True), ("specific", "specific", True), "manifolds"),
+    "plm_general": (("general", "general", True), ("specific", "general", True), "manifolds"),
+    "plm_top": (("specific", "specific", True), ("specific", "specific", True), "top"),
+    "plm_nonexclusive": (("specific", "specific", False), ("specific", "specific", False),
+                         "manifolds"),
+}
+PRIOR_FLOOR = 0.02  # the pipeline's (PipelineConfig.prior_floor): a prior that misses the true
+# category cannot make perceived evidence impossible.
+CONFIDENT_PART = 0.5  # S_REAL: detected parts at least this likely are kept (as certain).
+
+
+@functools.lru_cache(maxsize=None)
+def _engine(category: str, grasp: str, exclusive: bool):
+    from tg_drake.logic.engine import LogicEngine
+    from tg_drake.logic.theory import TheoryConfig
+
+    return LogicEngine(TheoryConfig(category=category, grasp=grasp, exclusive=exclusive))
+
+
+def _round(v) -> list[float]:
+    return [round(float(x), 6) for x in v]
+
+
+def _prior(kind: str, priors: dict) -> dict | None:
+    if kind == "uniform":
+        return None
+    p = np.asarray(priors["manifolds"], dtype=float)
+    if kind == "top":
+        p = np.eye(len(CATEGORIES))[int(np.argmax(p))]
+    p = (1.0 - PRIOR_FLOOR) * p + PRIOR_FLOOR / len(CATEGORIES)
+    return dict(zip(CATEGORIES, p.tolist()))
+
+
+def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS) -> dict:
+    """Every method's category and task distributions (task inferred) and, for each task of the
+    ground truth, its part distribution. An impossible observation (probability 0) is recorded
+    as the error it is, with no distributions."""
+    from tg_drake.logic.observations import Observations
+
+    out = {}
+    for name, (cat_theory, grasp_theory, prior_kind) in methods.items():
+        prior = _prior(prior_kind, priors)
+
+        def obs(task=None):
+            return Observations(parts=observations.parts, pose=observations.pose,
+                                containment=observations.containment, category_prior=prior,
+                                task=task, handles=observations.handles)
+
+        try:
+            answer = _engine(*cat_theory).query(obs())
+            parts = {t: _round(_engine(*grasp_theory).query(obs(t)).part) for t in truth_tasks}
+            out[name] = {"category": _round(answer.category), "task": _round(answer.task),
+                         "part": parts}
+        except RuleError as e:
+            out[name] = {"error": str(e)}
+    return out
+
+
+def kernel_priors(points, normals, labels, *, object_id: str, t: int) -> dict:
+    """Label fractions (T = 0) and Manifolds (T = t) priors, leave-one-object-out."""
+    from tg_drake.kernels.database import load_database
+
+    db = load_database()
+    return {name: _round(db.prior(points, normals, labels, t=T,
+                                  exclude_object=object_id).probabilities)
+            for name, T in (("label_fractions", 0), ("manifolds", t))}
+
+
+def _seed(key: str, seed: int) -> int:
+    return zlib.crc32(key.encode()) + 1_000_003 * seed
+
+
+def run_synthetic(case) -> dict:
+    from tg_drake.kernels.database import load_database
+    from tg_drake.kernels.library import sample_object
+    from tg_drake.logic.observations import Observations, handle_count
+    from tg_drake.objects import get_object, mesh
+
+    placement = case.target_placement
+    obj = get_object(placement.id)
+    vertices, _, labels = mesh(obj)
+    handles = handle_count(vertices, labels) if "handle" in obj.parts else 1
+    observations = Observations(parts={p: 1.0 for p in obj.parts}, pose={placement.pose: 1.0},
+                                containment={placement.containment: 1.0}, handles=handles)
+    cloud = sample_object(obj, spacing=load_database().spacing,
+                          rng=np.random.default_rng(_seed(case.key, case.seed)))
+    priors = kernel_priors(cloud.points, cloud.normals, cloud.labels, object_id=obj.id,
+                           t=case.kernel_T)
+    return {**case.meta(), "priors": priors,
+            "methods": logic_answers(observations, priors, case.truth.tasks)}
+
+
+# The default scenario camera relative to the object (tools/eval_kernel_prior.py uses the same).
+P_CAMERA = (0.8, 0.0, 0.55)  # [m] eye, from the object's table point
+P_TARGET = (0.0, 0.0, 0.05)  # [m] looked-at point
+
+
+def perceive(object_id: str, pose: str, yaw_deg: float):
+    """The perception stage's description of a library object alone on a table, from its depth
+    image ray cast (640×480, 45° vertical field of view) from the default camera's viewpoint."""
+    import open3d as o3d
+
+    from tg_drake.objects import get_object, mesh
+    from tg_drake.perception.geometry import Intrinsics
+    from tg_drake.perception.pipeline import describe_scene
+    from tg_drake.perception.synthetic import look_at, render_depth, table_mesh
+
+    obj = get_object(object_id)
+    intrinsics = Intrinsics.from_fov(640, 480, np.deg2rad(45.0))
+    X_WC = look_at(np.array(P_CAMERA), np.array(P_TARGET))
+    c, s = np.cos(np.deg2rad(yaw_deg)), np.sin(np.deg2rad(yaw_deg))
+    X_WO = np.eye(4)
+    X_WO[:2, :2] = [[c, -s], [s, c]]
+    X_WO = X_WO @ obj.resting_pose(pose).X_TO
+    V, F, _ = mesh(obj)
+    m = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(np.array(V, float)),
+                                  o3d.utility.Vector3iVector(np.array(F, np.int32)))
+    m.transform(X_WO)
+    scene = describe_scene(render_depth([table_mesh(), m], intrinsics, X_WC), intrinsics, X_WC)
+    if not scene.objects:
+        raise PerceptionError("no object found on the table")
+    p_com = (X_WO @ np.r_[obj.com, 1.0])[:2]  # the cluster nearest to the object's centre
+    return min(scene.objects, key=lambda o: np.linalg.norm(o.p_W[:, :2].mean(axis=0) - p_com))
+
+
+def setting_observations(description, setting: str, *, true_pose: str, containment: str):
+    """Observations of a perceived object in one of the paper's S_REAL settings."""
+    from tg_drake.logic.observations import Observations, count_handles
+
+    detected = {p: float(v) for p, v in description.part_probabilities.items() if v > 0}
+    if setting == "semi":
+        parts, pose = {p: 1.0 for p in detected}, {true_pose: 1.0}
+    elif setting == "real":
+        parts = {p: 1.0 for p, v in detected.items() if v >= CONFIDENT_PART}
+        pose = dict(description.pose_likelihood)
+    else:
+        parts, pose = detected, dict(description.pose_likelihood)
+    return Observations(parts=parts, pose=pose, containment={containment: 1.0},
+                        handles=count_handles(description))
+
+
+def run_perceived(case) -> list[dict]:
+    from tg_drake.evaluation.suite import DATASET_OF_SETTING
+    from tg_drake.objects import get_object
+
+    placement = case.target_placement
+    obj = get_object(placement.id)
+    meta = case.meta()
+    try:
+        d = perceive(obj.id, placement.pose, placement.yaw)
+        detection = {"found_pose": d.pose, "found_parts": sorted(
+            p for p, v in d.part_probabilities.items() if v > 0)}
+        priors = kernel_priors(d.p_W, d.n_W, d.labels, object_id=obj.id, t=case.kernel_T)
+    except TgDrakeError as e:  # perception found nothing usable: a failure of every method
+        detection, priors, d = {"found_pose": None, "found_parts": None, "error": str(e)}, None, None
+    detection["pose_ok"] = detection["found_pose"] == placement.pose
+    detection["parts_ok"] = detection["found_parts"] == sorted(obj.parts)
+    records = []
+    for setting in case.settings:
+        record = {**meta, "dataset": DATASET_OF_SETTING[setting], "setting": setting,
+                  "detection": detection, "priors": priors}
+        if d is not None:
+            obs = setting_observations(d, setting, true_pose=placement.pose,
+                                       containment=placement.containment)
+            record["observed_parts"] = sorted(obs.parts)
+            record["methods"] = logic_answers(obs, priors, case.truth.tasks)
+        records.append(record)
+    return records
+
+
+def run_executed(case) -> dict:
+    from tg_drake.run import run_scenario
+    from tg_drake.scenario import PipelineConfig, Scenario, TaskConfig, validate
+
+    pipeline = PipelineConfig(use_prior=case.variant != "pipeline_uniform",
+                              grasp_selection="local_only" if case.variant == "local"
+                              else "pipeline")
+    scenario = Scenario(objects=list(case.objects), pipeline=pipeline,
+                        task=TaskConfig(target=case.target, task=case.task,
+                                        place_xy=list(case.place_xy)))
+    validate(scenario, where=case.key)
+    result = run_scenario(scenario, scenario_path=case.key)
+    keep = ("perception", "category_prior", "category", "task", "part", "grasp",
+            "grasp_probability", "n_hypotheses", "planning", "outcome", "timings")
+    return {**case.meta(), **{k: result[k] for k in keep if k in result}}
+
+
+def run_case(case) -> dict | list[dict]:
+    """Runs one case of any kind (the sweep's job function)."""
+    if case.kind == "synthetic":
+        return run_synthetic(case)
+    if case.kind == "perceived":
+        return run_perceived(case)
+    return run_executed(case)
