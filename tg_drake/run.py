@@ -56,6 +56,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--meshcat", action="store_true",
                         help="serve Drake's Meshcat viewer on localhost and replay the run there")
     parser.add_argument("--no-images", action="store_true", help="skip the PNG pictures")
+    parser.add_argument("--theory", choices=("specific", "general", "learned"), default=None,
+                        help="both models of this theory variant, overriding the scenario's "
+                        "pipeline.category_theory and grasp_theory")
 
 
 def _distribution(d: dict) -> dict:
@@ -368,6 +371,8 @@ def main(args) -> int:
     from tg_drake.scenario import load_scenario
 
     scenario = load_scenario(args.scenario, scenario_name=args.name)
+    if getattr(args, "theory", None):
+        scenario.pipeline.category_theory = scenario.pipeline.grasp_theory = args.theory
     out = args.out or Path("out") / (args.name or args.scenario.stem)
     out.mkdir(parents=True, exist_ok=True)
     meshcat = None

@@ -16,8 +16,10 @@ HELP = "ask the ProbLog theory for category, task and pre-grasp part on given ob
 def add_arguments(parser) -> None:
     parser.add_argument("observations", type=Path, help="observations file (YAML)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
-    parser.add_argument("--theory", choices=("specific", "general"), default="specific",
-                        help="category and grasp model variant (default: specific)")
+    parser.add_argument("--theory", choices=("specific", "general", "learned"),
+                        default="specific",
+                        help="category and grasp model variant (default: specific; learned: "
+                        "fitted by tools/learn_theory.py)")
     parser.add_argument("--non-exclusive", action="store_true",
                         help="normalise marginals instead of mutually exclusive outcomes")
     parser.add_argument("--uniform", action="store_true",

@@ -34,7 +34,9 @@ from problog.program import PrologFile
 
 from tg_drake.errors import RuleError, unknown_name
 
-VARIANTS: tuple[str, ...] = ("specific", "general")
+# "learned": the probabilities fitted to simulated grasps (tg_drake/logic/learning.py,
+# tools/learn_theory.py), in rules/category_learned.pl and rules/grasp_learned.pl.
+VARIANTS: tuple[str, ...] = ("specific", "general", "learned")
 
 # Files of every variant, in load order; {category} and {grasp} are the variant names.
 THEORY_FILES: tuple[str, ...] = (
@@ -53,7 +55,8 @@ THEORY_FILES: tuple[str, ...] = (
 # and the query atoms are definitions: taking one out breaks every answer at once and says nothing.
 EXPLAINING_FILES: frozenset[str] = frozenset({
     "affordances.pl", "category_spread.pl", "category_specific.pl", "category_general.pl",
-    "grasp_specific.pl", "grasp_general.pl", "constraints.pl",
+    "grasp_specific.pl", "grasp_general.pl", "constraints.pl", "category_learned.pl",
+    "grasp_learned.pl",
 })
 
 RULES_ENV = "TG_DRAKE_RULES"
