@@ -123,7 +123,8 @@ def allowed_parts(category: str, pose: str, containment: str, task: str) -> froz
     _check(task, TASKS, "task")
     if task not in afforded_tasks(category, containment):
         return frozenset()
-    parts = set(PART_LABELS)
+    parts = {"handle", "usable_area"} if KIND[category] == "tool" else set(PART_LABELS) - {
+        "usable_area"}
     final = _FINAL_POSE.get(task, pose if task == "p&pOn" else None)
     if final == "upright":  # rest
         parts.discard("bottom")
@@ -423,11 +424,17 @@ def check_interpretations(interpretations: Sequence[Interpretation], program: li
 
 def fit(interpretations: Sequence[Interpretation], *, model: str = "grasp",
         variant: str = "specific", directory: Path | None = None, max_iter: int = 50,
-        min_improvement: float = 1e-6) -> FitResult:
+        min_improvement: float = 1e-6, prior_strength: float = 0.0) -> FitResult:
     """Fits the tunable probabilities of `model` ("grasp" or "category") of the hand-written
     `variant` to the interpretations by ProbLog's LFI (EM), starting from the written values.
 
     EM is deterministic: the same interpretations in the same order give the same numbers.
+    `prior_strength` m > 0 turns the estimate into a MAP one with a Beta (one head) or Dirichlet
+    (an annotated disjunction) prior centred on the hand-written value p0 and worth m
+    interpretations: p = (n·p_LFI + m·p0) / (n + m), n the interpretations in which the clause's
+    body held. It keeps a probability of a clause with little data near its written value and
+    away from exactly 0 or 1 (with the theory's independent grasp rules, two parts at 1 would
+    make "exactly one part is grasped" impossible). 0 gives the plain maximum likelihood.
     Interpretations whose evidence the theory makes impossible (a served grasp it has no rule
     for in that scene) are dropped and listed (`FitResult.dropped`).
     """
@@ -435,9 +442,13 @@ def fit(interpretations: Sequence[Interpretation], *, model: str = "grasp",
     from problog.learning.lfi import LFIProblem
     from problog.program import SimpleProgram
 
+    if prior_strength < 0:
+        raise RuleError(f"prior_strength must be >= 0, got {prior_strength}",
+                        field="prior_strength")
     if variant not in ("specific", "general"):
         raise unknown_name("variant", variant, ("specific", "general"), error=RuleError,
                            field="variant")
+    model_file(model, variant)  # an unknown model is a RuleError.
     program, tunables, functors = _program(model, variant, directory)
     check_interpretations(interpretations, program)
     kept, dropped, counts = _analyse(interpretations, tunables, program)
@@ -460,7 +471,9 @@ def fit(interpretations: Sequence[Interpretation], *, model: str = "grasp",
         if n == 0:
             after = before
         else:
-            after = _unstick([learned.get(f, q) for f, q in zip(chain, _stick(before))])
+            mle = _unstick([learned.get(f, q) for f, q in zip(chain, _stick(before))])
+            after = [(n * a + prior_strength * b) / (n + prior_strength)
+                     for a, b in zip(mle, before)]
         clauses.append(LearnedClause(source_clause.file, source_clause.line, source_clause.text,
                                      before, [round(a, 4) for a in after], n))
     return FitResult(model, variant, clauses, log_likelihood, int(lfi.iteration), len(kept),

@@ -1,0 +1,133 @@
+% LEARNED grasp model: the probabilities of grasp_specific.pl fitted by ProbLog's learning from interpretations (EM, 2 iterations, log-likelihood -124.29),
+% starting from the hand-written values; data: 15 executed grasps of 15 scenes of the training objects (data/learning/grasps.jsonl), 26 interpretations (a grasp that served an afforded task), 1 dropped (no rule for the served part).
+% Made by: python tools/learn_theory.py --stage fit
+% Clauses without data keep their hand-written values. Do not edit: rerun the command (tg_drake/logic/learning.py says what is tunable and why).
+%
+% Task-dependent grasp model, specific variant (paper IV-C): CP-events that make a part graspable
+% for a task, given the object's super-category, pose and containment. One block per super-category
+% (the four that partition the categories: dish, kitchen_container, canister, tool) and task; the
+% causal probability is how suitable the part is. Blocks marked "paper" are the paper's; the rest are
+% ours (rules/README.md, table 5). A part is only grasped if it was observed (part/2 in the body).
+
+
+% ---- dish (cup, glass, bowl) ----
+% pass, upright, full (paper)
+0.8::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), full(X), part(middle, X).
+0.1::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), full(X), part(top, X).
+0.1::grasp(X, T, handle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), full(X), part(handle, X).
+% pass, upright, empty (paper)
+0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(bottom, X).
+0.5::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(middle, X).
+0.5::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(top, X).
+% pass, upside down (paper)
+0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upsidedown), part(bottom, X).
+1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upsidedown), part(middle, X).
+0.0::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upsidedown), part(top, X).
+% pass, sideways (ours)
+0.7::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, sideways), part(middle, X).
+0.2::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, sideways), part(bottom, X).
+0.1::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, sideways), part(top, X).
+% pourOut, full (paper: not(empty(X)))
+1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pour_out), kind(X, dish), full(X), part(middle, X).
+% pourIn, empty (paper)
+1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pour_in), kind(X, dish), empty(X), part(middle, X).
+% p&pIn, sideways (paper)
+0.7::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, sideways), part(middle, X).
+0.3::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, sideways), part(bottom, X).
+% p&pIn, upright (ours)
+1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upright), part(middle, X).
+0.0::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upright), part(top, X).
+% p&pIn, upside down (ours)
+1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upsidedown), part(middle, X).
+0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upsidedown), part(bottom, X).
+% p&pOn, upright (ours)
+0.5::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upright), part(middle, X).
+0.5::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upright), part(top, X).
+% p&pOn, sideways (ours)
+0.7::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, sideways), part(middle, X).
+0.3::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, sideways), part(bottom, X).
+% p&pOn, upside down (ours)
+1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upsidedown), part(middle, X).
+0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upsidedown), part(bottom, X).
+
+% ---- kitchen_container (pan, pot): held by the handle (ours) ----
+% pass, upright, empty
+0.6::grasp(X, T, handle) :- affords(X, T), isa_task(T, pass), kind(X, kitchen_container), pose(X, upright), empty(X), part(handle, X).
+0.3::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, kitchen_container), pose(X, upright), empty(X), part(top, X).
+0.1::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, kitchen_container), pose(X, upright), empty(X), part(middle, X).
+% pass, upright, full
+0.8::grasp(X, T, handle) :- affords(X, T), isa_task(T, pass), kind(X, kitchen_container), pose(X, upright), full(X), part(handle, X).
+0.1::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, kitchen_container), pose(X, upright), full(X), part(middle, X).
+% pass, sideways
+0.7::grasp(X, T, handle) :- affords(X, T), isa_task(T, pass), kind(X, kitchen_container), pose(X, sideways), part(handle, X).
+0.3::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, kitchen_container), pose(X, sideways), part(middle, X).
+% pass, upside down
+0.7::grasp(X, T, handle) :- affords(X, T), isa_task(T, pass), kind(X, kitchen_container), pose(X, upsidedown), part(handle, X).
+0.3::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, kitchen_container), pose(X, upsidedown), part(bottom, X).
+% pourIn, empty
+0.8::grasp(X, T, handle) :- affords(X, T), isa_task(T, pour_in), kind(X, kitchen_container), empty(X), part(handle, X).
+0.2::grasp(X, T, middle) :- affords(X, T), isa_task(T, pour_in), kind(X, kitchen_container), empty(X), part(middle, X).
+% p&pIn, upright
+0.7::grasp(X, T, handle) :- affords(X, T), isa_task(T, pp_in), kind(X, kitchen_container), pose(X, upright), part(handle, X).
+0.3::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_in), kind(X, kitchen_container), pose(X, upright), part(top, X).
+% p&pIn, sideways
+0.7::grasp(X, T, handle) :- affords(X, T), isa_task(T, pp_in), kind(X, kitchen_container), pose(X, sideways), part(handle, X).
+0.3::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, kitchen_container), pose(X, sideways), part(middle, X).
+% p&pIn, upside down
+0.7::grasp(X, T, handle) :- affords(X, T), isa_task(T, pp_in), kind(X, kitchen_container), pose(X, upsidedown), part(handle, X).
+0.3::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, kitchen_container), pose(X, upsidedown), part(bottom, X).
+% p&pOn, upright
+0.7::grasp(X, T, handle) :- affords(X, T), isa_task(T, pp_on), kind(X, kitchen_container), pose(X, upright), part(handle, X).
+0.3::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_on), kind(X, kitchen_container), pose(X, upright), part(top, X).
+% p&pOn, sideways
+0.7::grasp(X, T, handle) :- affords(X, T), isa_task(T, pp_on), kind(X, kitchen_container), pose(X, sideways), part(handle, X).
+0.3::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, kitchen_container), pose(X, sideways), part(middle, X).
+% p&pOn, upside down
+0.7::grasp(X, T, handle) :- affords(X, T), isa_task(T, pp_on), kind(X, kitchen_container), pose(X, upsidedown), part(handle, X).
+0.3::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, kitchen_container), pose(X, upsidedown), part(bottom, X).
+
+% ---- canister (bottle, can): held round the body (ours) ----
+% pass, upright
+0.3333::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upright), part(middle, X).
+0.6667::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upright), part(top, X).
+0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upright), part(bottom, X).
+% pass, sideways
+0.8::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, sideways), part(middle, X).
+0.1::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, sideways), part(top, X).
+0.1::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, sideways), part(bottom, X).
+% pass, upside down
+0.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upsidedown), part(middle, X).
+1.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upsidedown), part(bottom, X).
+0.0::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upsidedown), part(top, X).
+% pourOut, full
+1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pour_out), kind(X, canister), full(X), part(middle, X).
+0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pour_out), kind(X, canister), full(X), part(bottom, X).
+% p&pIn, upright
+0.5::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upright), part(middle, X).
+0.5::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upright), part(top, X).
+% p&pIn, sideways
+0.8::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, sideways), part(middle, X).
+0.2::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, sideways), part(bottom, X).
+% p&pIn, upside down
+0.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upsidedown), part(middle, X).
+1.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upsidedown), part(bottom, X).
+% p&pOn, upright
+0.3333::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upright), part(middle, X).
+0.6667::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upright), part(top, X).
+% p&pOn, sideways
+0.8::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, sideways), part(middle, X).
+0.2::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, sideways), part(bottom, X).
+% p&pOn, upside down
+0.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upsidedown), part(middle, X).
+1.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upsidedown), part(bottom, X).
+
+% ---- tool (hammer, knife, screwdriver, cooking_tool) ----
+% pass: by the usable area, the receiver takes the handle (paper, IV)
+0.8::grasp(X, T, usable_area) :- affords(X, T), isa_task(T, pass), kind(X, tool), part(usable_area, X).
+0.2::grasp(X, T, handle) :- affords(X, T), isa_task(T, pass), kind(X, tool), part(handle, X).
+% p&pInSideways (ours)
+0.8::grasp(X, T, handle) :- affords(X, T), isa_task(T, pp_in_sideways), kind(X, tool), part(handle, X).
+0.2::grasp(X, T, usable_area) :- affords(X, T), isa_task(T, pp_in_sideways), kind(X, tool), part(usable_area, X).
+% p&pOn (ours)
+0.8::grasp(X, T, handle) :- affords(X, T), isa_task(T, pp_on), kind(X, tool), part(handle, X).
+0.2::grasp(X, T, usable_area) :- affords(X, T), isa_task(T, pp_on), kind(X, tool), part(usable_area, X).
