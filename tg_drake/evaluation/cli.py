@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import shlex
 import sys
+import zlib
 from pathlib import Path
 
 HELP = "run evaluation suites (progress bar, resumable results.jsonl) and write the paper's tables"
@@ -33,6 +34,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--address", default=None, help="Ray cluster address (e.g. auto)")
     parser.add_argument("--retry-errors", action="store_true",
                         help="run again the cases recorded as errors")
+    parser.add_argument("--tables", type=Path, default=None,
+                        help="folder for tables.json, tables.md and the plots (default: --out)")
     parser.add_argument("--tables-only", action="store_true",
                         help="only derive the tables and plots from DIR/results.jsonl")
 
@@ -40,19 +43,37 @@ def add_arguments(parser) -> None:
 def load_cases(paths) -> list:
     """The cases of several suites, executed runs grouped by scenario (their variants side by
     side, so that a sweep cut short still compares the variants on the scenarios it ran)."""
-    from tg_drake.errors import ScenarioError
     from tg_drake.evaluation.suite import load_suite
 
     cases = []
     for path in paths:
         cases += load_suite(path)[1]
+    return _ordered(cases)
+
+
+def suite_notes(paths) -> str:
+    """A Markdown list of the suites: name, cases, description."""
+    from tg_drake.evaluation.suite import load_suite
+
+    lines = ["Suites:", ""]
+    for path in paths:
+        suite, cases = load_suite(path)
+        lines.append(f"- `{path}` ({len(cases)} cases): {' '.join(suite.description.split())}")
+    return "\n".join(lines)
+
+
+def _ordered(cases) -> list:
+    from tg_drake.errors import ScenarioError
+
     keys = [c.key for c in cases]
     if len(set(keys)) != len(keys):
         dup = sorted({k for k in keys if keys.count(k) > 1})
         raise ScenarioError(f"the same case in two suites (a suite given twice?): {dup[0]}")
+    # Executed runs in a fixed shuffled order of their scenarios (a sweep cut short is a sample
+    # of every category and scene), each scenario's variants together.
     order = {"synthetic": 0, "perceived": 1, "executed": 2}
-    return sorted(cases, key=lambda c: (order[c.kind], c.key.split("/", 1)[1].split("@")[0]
-                                        if c.kind == "executed" else ""))
+    return sorted(cases, key=lambda c: (order[c.kind], zlib.crc32(
+        c.key.split("/", 1)[1].split("@")[0].encode()) if c.kind == "executed" else 0))
 
 
 def read_records(out: Path, cases) -> list[dict]:
@@ -61,29 +82,27 @@ def read_records(out: Path, cases) -> list[dict]:
     from tg_drake.evaluation.suite import DATASET_OF_SETTING
 
     by_key = {c.key: c for c in cases}
-    records = []
     if not out.exists():
-        return records
-    seen_error = set()
+        return []
+    lines: dict[str, list[dict]] = {}
     for line in out.read_text().splitlines():
         try:
             r = json.loads(line)
         except json.JSONDecodeError:
             continue  # a line cut by a killed run
-        case = by_key.get(r.get("job"))
-        if case is None:
+        if r.get("job") in by_key:
+            lines.setdefault(r["job"], []).append(r)
+    records = []
+    for key, rs in lines.items():
+        ok = [r for r in rs if r.get("status") != "error"]
+        if ok:  # a case rerun after an error (--retry-errors) keeps its good records
+            records += ok
             continue
-        if r.get("status") == "error":
-            if case.key in seen_error:
-                continue
-            seen_error.add(case.key)
-            meta = case.meta()
-            for setting in case.settings or [None]:
-                records.append({"job": case.key, **meta, "error": r.get("reason", ""),
-                                **({"setting": setting, "dataset": DATASET_OF_SETTING[setting]}
-                                   if setting else {})})
-        else:
-            records.append(r)
+        case, meta = by_key[key], by_key[key].meta()
+        for setting in case.settings or [None]:
+            records.append({"job": key, **meta, "error": rs[-1].get("reason", ""),
+                            **({"setting": setting, "dataset": DATASET_OF_SETTING[setting]}
+                               if setting else {})})
     return records
 
 
@@ -113,9 +132,11 @@ def main(args) -> int:
     records = read_records(out, cases)
     command = "tg-drake eval " + " ".join(shlex.quote(a) for a in sys.argv[2:]) \
         if sys.argv[1:2] == ["eval"] else "tg-drake eval " + " ".join(map(str, args.suites))
-    tables = write_tables(args.out, records, command)
+    folder = args.tables or args.out
+    folder.mkdir(parents=True, exist_ok=True)
+    tables = write_tables(folder, records, command, notes=suite_notes(args.suites))
     done = {r["job"] for r in records}
-    print(f"{len(done)} of {len(cases)} cases have records; tables in {args.out}/tables.md "
+    print(f"{len(done)} of {len(cases)} cases have records; tables in {folder}/tables.md "
           f"({tables['n_errors']} crashed cases counted as failures)")
     return 0
 
