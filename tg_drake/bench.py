@@ -25,6 +25,7 @@ FIGURES: dict[str, str] = {
     "perception_ms": "tg_drake.perception.bench:perception_ms",
     "segmentation_ms": "tg_drake.perception.bench:segmentation_ms",
     "dgi_us_per_hypothesis": "tg_drake.grasping.bench:dgi_us_per_hypothesis",
+    "sweep_efficiency": "tg_drake.evaluation.bench:sweep_efficiency",
     "pipeline_rtf": "tg_drake.run:bench_pipeline_rtf",
 }
 

@@ -1,0 +1,43 @@
+"""Speed figure of the sweep engine: `sweep_efficiency`.
+
+A small evaluation sweep — the first 16 cases of the S_REAL suite (render, perceive, kernel prior,
+every logic method; about 0.3–2 s each) — run by the local process pool with 2 workers, against
+the same sweep with 1 worker. Each run starts a fresh pool and writes its own results file, so the
+time includes spawning the workers and compiling the theories in each, as a user's sweep does.
+speedup = time with 1 worker / time with 2 workers: 2 is perfect scaling on this machine.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+
+from tg_drake.bench import Figure, figure
+
+N_CASES = 16
+
+
+def _sweep_seconds(cases, workers: int) -> float:
+    from tg_drake.evaluation.cli import _run
+    from tg_drake.executor import Job, LocalExecutor, run_jobs
+
+    with tempfile.TemporaryDirectory() as folder:
+        t0 = time.perf_counter()
+        run_jobs(_run, [Job(c.key, c) for c in cases], out=Path(folder) / "results.jsonl",
+                 executor=LocalExecutor(workers), progress=False)
+        return time.perf_counter() - t0
+
+
+def sweep_efficiency() -> Figure:
+    """Seconds for the sweep with 2 workers (one run; reference: one run with 1 worker)."""
+    from importlib.resources import files
+
+    from tg_drake.evaluation.suite import load_suite
+
+    suite = Path(str(files("tg_drake"))).parent / "scenarios" / "suites" / "s_real.yaml"
+    cases = load_suite(suite)[1][:N_CASES]
+    one = _sweep_seconds(cases, 1)
+    two = _sweep_seconds(cases, 2)
+    return figure(two, "s", f"the same sweep of {N_CASES} S_REAL cases with 1 worker (a fresh "
+                  "local pool each; speed-up 2 = perfect scaling over 2 workers)", one)
