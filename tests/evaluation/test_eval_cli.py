@@ -112,3 +112,16 @@ def test_the_same_sweep_runs_on_a_local_ray_instance(tiny_run, tmp_path):
     assert remote.keys() == local.keys()
     for key, r in remote.items():  # the same answers: seeded per case, not per worker
         assert r["methods"] == local[key]["methods"] and r["priors"] == local[key]["priors"]
+
+
+def test_another_theory_variant_runs_under_its_own_keys(tmp_path, capsys):
+    assert eval_(TINY, "--out", tmp_path, "--workers", "0", "--theory", "learnt") == 2
+    assert "field '--theory': unknown theory 'learnt'; allowed: specific, general" in \
+        capsys.readouterr().err
+    assert eval_(TINY, "--out", tmp_path, "--workers", "0", "--theory", "learned") == 0
+    records = lines(tmp_path / "results.jsonl")
+    assert {r["job"] for r in records} == {
+        "tiny/cup_01_sideways_empty#learned", "tiny/cup_01_upright_empty#learned",
+        "tiny/hammer_01_sideways_empty#learned"}
+    assert {r["theory"] for r in records} == {"learned"}
+    assert all("category" in r["methods"]["plm"] for r in records)

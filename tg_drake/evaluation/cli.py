@@ -11,6 +11,7 @@ given. `--tables-only` derives the tables from the records already there.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shlex
 import sys
@@ -32,6 +33,10 @@ def add_arguments(parser) -> None:
                         help="worker processes (local; default one per core; 0 = in this process)"
                              " or jobs in flight (ray)")
     parser.add_argument("--address", default=None, help="Ray cluster address (e.g. auto)")
+    parser.add_argument("--theory", default="specific",
+                        help="model variant in place of the specific one for PLM and the pipeline "
+                             "(tg_drake.scenario.THEORY_VARIANTS, e.g. learned); a case's key "
+                             "gets '#<theory>' unless it is specific")
     parser.add_argument("--retry-errors", action="store_true",
                         help="run again the cases recorded as errors")
     parser.add_argument("--tables", type=Path, default=None,
@@ -122,6 +127,15 @@ def main(args) -> int:
     from tg_drake.executor import Job, make_executor, run_jobs
 
     cases = load_cases(args.suites)
+    if args.theory != "specific":
+        from tg_drake.errors import ScenarioError, unknown_name
+        from tg_drake.scenario import THEORY_VARIANTS
+
+        if args.theory not in THEORY_VARIANTS:
+            raise unknown_name("theory", args.theory, THEORY_VARIANTS, error=ScenarioError,
+                               field="--theory")
+        cases = [dataclasses.replace(c, key=f"{c.key}#{args.theory}", theory=args.theory)
+                 for c in cases]
     out = args.out / "results.jsonl"
     if not args.tables_only:
         executor = make_executor(args.executor, workers=args.workers, address=args.address)

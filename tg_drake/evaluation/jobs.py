@@ -63,14 +63,20 @@ def _prior(kind: str, priors: dict) -> dict | None:
     return dict(zip(CATEGORIES, p.tolist()))
 
 
-def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS) -> dict:
+def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS,
+                  theory: str = "specific") -> dict:
     """Every method's category and task distributions (task inferred) and, for each task of the
-    ground truth, its part distribution. An impossible observation (probability 0) is recorded
-    as the error it is, with no distributions."""
+    ground truth, its part distribution. `theory` stands in for the specific model variant (e.g.
+    "learned"). An impossible observation (probability 0) is recorded as the error it is, with no
+    distributions."""
     from tg_drake.logic.observations import Observations
+
+    def variant(models):
+        return tuple(theory if m == "specific" else m for m in models[:2]) + models[2:]
 
     out = {}
     for name, (cat_theory, grasp_theory, prior_kind) in methods.items():
+        cat_theory, grasp_theory = variant(cat_theory), variant(grasp_theory)
         prior = _prior(prior_kind, priors)
 
         def obs(task=None):
@@ -119,7 +125,8 @@ def run_synthetic(case) -> dict:
     priors = kernel_priors(cloud.points, cloud.normals, cloud.labels, object_id=obj.id,
                            t=case.kernel_T)
     return {**case.meta(), "priors": priors,
-            "methods": logic_answers(observations, priors, case.truth.tasks)}
+            "methods": logic_answers(observations, priors, case.truth.tasks,
+                                       theory=case.theory)}
 
 
 # The default scenario camera relative to the object (tools/eval_kernel_prior.py uses the same).
@@ -195,7 +202,8 @@ def run_perceived(case) -> list[dict]:
             obs = setting_observations(d, setting, true_pose=placement.pose,
                                        containment=placement.containment)
             record["observed_parts"] = sorted(obs.parts)
-            record["methods"] = logic_answers(obs, priors, case.truth.tasks)
+            record["methods"] = logic_answers(obs, priors, case.truth.tasks,
+                                                  theory=case.theory)
         records.append(record)
     return records
 
@@ -204,7 +212,8 @@ def run_executed(case) -> dict:
     from tg_drake.run import run_scenario
     from tg_drake.scenario import PipelineConfig, Scenario, TaskConfig, validate
 
-    pipeline = PipelineConfig(use_prior=case.variant != "pipeline_uniform",
+    pipeline = PipelineConfig(category_theory=case.theory, grasp_theory=case.theory,
+                              use_prior=case.variant != "pipeline_uniform",
                               grasp_selection="local_only" if case.variant == "local"
                               else "pipeline")
     scenario = Scenario(objects=list(case.objects), pipeline=pipeline,

@@ -145,6 +145,7 @@ class Case:
     settings: tuple[str, ...] = ()  # perceived
     kernel_T: int = 13
     seed: int = 0
+    theory: str = "specific"  # the model variant standing in for "specific" (PLM, pipeline)
 
     @property
     def target_placement(self) -> ObjectPlacement:
@@ -159,7 +160,7 @@ class Case:
                 "variant": self.variant, "object": p.id, "pose": p.pose, "yaw": p.yaw,
                 "containment": p.containment, "object_parts": list(get_object(p.id).parts),
                 "n_objects": len(self.objects),
-                "task_given": self.task, "truth": {
+                "task_given": self.task, "theory": self.theory, "truth": {
                     "category": self.truth.category, "tasks": list(self.truth.tasks),
                     "parts": {t: list(v) for t, v in self.truth.parts.items()},
                     "reason": self.truth.reason}}
