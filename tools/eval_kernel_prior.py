@@ -91,49 +91,23 @@ def summarise(per_seed: list[list[Score]]) -> dict:
 
 
 YAWS_DEG = (0.0, 120.0, 240.0)  # object turns about the table normal, per resting pose.
-P_CAMERA = (0.8, 0.0, 0.55)  # [m] camera eye relative to the object's table point ...
-P_TARGET = (0.0, 0.0, 0.05)  # [m] ... looking at this point (as the default scenario camera).
 
 
 def perceived_views(object_ids=None) -> tuple[list[dict], list[dict]]:
-    """Perceived clouds of library objects: (views, failures), one view per pose × yaw."""
-    import open3d as o3d
+    """Perceived clouds of library objects: (views, failures), one view per pose × yaw
+    (`tg_drake.evaluation.jobs.perceive`: ray cast from the default camera's viewpoint)."""
+    from tg_drake.evaluation.jobs import perceive
 
-    from tg_drake.objects import mesh
-    from tg_drake.perception.geometry import Intrinsics
-    from tg_drake.perception.pipeline import describe_scene
-    from tg_drake.perception.synthetic import look_at, render_depth, table_mesh
-
-    intrinsics = Intrinsics.from_fov(640, 480, np.deg2rad(45.0))
-    X_WC = look_at(np.array(P_CAMERA), np.array(P_TARGET))
-    table = table_mesh()
     library = load_library()
     views, failures = [], []
     for obj in (library.values() if object_ids is None else [library[i] for i in object_ids]):
-        V, F, _ = mesh(obj)
-        for pose, resting in obj.poses.items():
+        for pose in obj.poses:
             for yaw in YAWS_DEG:
-                c, s_ = np.cos(np.deg2rad(yaw)), np.sin(np.deg2rad(yaw))
-                X_WO = np.eye(4)
-                X_WO[:2, :2] = [[c, -s_], [s_, c]]
-                X_WO = X_WO @ resting.X_TO
-                m = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(np.array(V, float)),
-                                              o3d.utility.Vector3iVector(np.array(F, np.int32)))
-                m.transform(X_WO)
-                depth = render_depth([table, m], intrinsics, X_WC)
                 entry = {"object": obj.id, "category": obj.category, "pose": pose, "yaw": yaw}
                 try:
-                    scene = describe_scene(depth, intrinsics, X_WC)
-                    if not scene.objects:
-                        raise PerceptionError("no object found on the table")
+                    views.append({**entry, "description": perceive(obj.id, pose, yaw)})
                 except PerceptionError as e:
                     failures.append({**entry, "reason": str(e)})
-                    continue
-                # The cluster nearest to where the object's centre of mass stands.
-                p_com = (X_WO @ np.r_[obj.com, 1.0])[:2]
-                found = min(scene.objects,
-                            key=lambda o: np.linalg.norm(o.p_W[:, :2].mean(axis=0) - p_com))
-                views.append({**entry, "description": found})
     return views, failures
 
 

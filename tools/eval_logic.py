@@ -43,6 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tg_drake.evaluation.tables import TIE, e_success, top_set
 from tg_drake.logic.engine import LogicEngine
 from tg_drake.logic.observations import Observations, handle_count
 from tg_drake.logic.theory import TheoryConfig
@@ -51,7 +52,6 @@ from tg_drake.types import CATEGORIES, PART_LABELS, TASKS
 
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
 KERNEL_T = 13  # the paper's T for the S_SYN priors fed to the PLM (section VI-C).
-TIE = 1e-9  # probabilities this close are tied (float rounding of the circuit is ~1e-15).
 
 # The paper's figures [%] (section VI-C, tables "object category", "task", "pre-grasp").
 PAPER = {
@@ -119,18 +119,6 @@ def kernel_priors(seed: int) -> dict[str, dict[str, float]]:
                          exclude_object=obj.id)
         priors[obj.id] = dict(zip(CATEGORIES, prior.probabilities.tolist()))
     return priors
-
-
-def top_set(p: np.ndarray) -> set[int]:
-    return set(np.flatnonzero(p >= p.max() - TIE)) if p.max() > 0 else set()
-
-
-def e_success(p: np.ndarray, truth: set[int], i: int) -> bool:
-    """E_i: the predictions down to the (|Gt| - i)-th largest (ties included) lie in Gt."""
-    k = max(len(truth) - i, 1)
-    threshold = np.sort(p)[::-1][k - 1]
-    predicted = set(np.flatnonzero(p >= threshold - TIE))
-    return threshold > 0 and predicted <= truth
 
 
 def with_prior(obs: Observations, prior: dict[str, float] | None, task: str | None = None):

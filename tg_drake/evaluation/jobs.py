@@ -129,7 +129,7 @@ def run_synthetic(case) -> dict:
                                        theory=case.theory)}
 
 
-# The default scenario camera relative to the object (tools/eval_kernel_prior.py uses the same).
+# The default scenario camera relative to the object (tools/eval_kernel_prior.py perceives so too).
 P_CAMERA = (0.8, 0.0, 0.55)  # [m] eye, from the object's table point
 P_TARGET = (0.0, 0.0, 0.05)  # [m] looked-at point
 
