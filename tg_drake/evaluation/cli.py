@@ -144,12 +144,22 @@ def main(args) -> int:
         print(f"{summary.n_jobs} cases: {summary.n_skipped} already done, {summary.n_ran} run now "
               f"({summary.n_errors} recorded as errors)", file=sys.stderr)
     records = read_records(out, cases)
-    command = "tg-drake eval " + " ".join(shlex.quote(a) for a in sys.argv[2:]) \
+    # The command that regenerates the tables: the sweep itself (it resumes, then derives them).
+    argv = [a for a in sys.argv[2:] if a != "--tables-only"]
+    command = "tg-drake eval " + " ".join(shlex.quote(a) for a in argv) \
         if sys.argv[1:2] == ["eval"] else "tg-drake eval " + " ".join(map(str, args.suites))
     folder = args.tables or args.out
     folder.mkdir(parents=True, exist_ok=True)
-    tables = write_tables(folder, records, command, notes=suite_notes(args.suites))
     done = {r["job"] for r in records}
+    per_suite = {}
+    for c in cases:
+        n = per_suite.setdefault(c.suite, [0, 0])
+        n[0] += c.key in done
+        n[1] += 1
+    coverage = (f"Cases with records: {len(done)} of {len(cases)} ("
+                + ", ".join(f"{s} {a}/{b}" for s, (a, b) in per_suite.items()) + ").")
+    tables = write_tables(folder, records, command,
+                          notes=suite_notes(args.suites) + "\n\n" + coverage)
     print(f"{len(done)} of {len(cases)} cases have records; tables in {folder}/tables.md "
           f"({tables['n_errors']} crashed cases counted as failures)")
     return 0
