@@ -134,9 +134,10 @@ P_CAMERA = (0.8, 0.0, 0.55)  # [m] eye, from the object's table point
 P_TARGET = (0.0, 0.0, 0.05)  # [m] looked-at point
 
 
-def perceive(object_id: str, pose: str, yaw_deg: float):
+def perceive(object_id: str, pose: str, yaw_deg: float, *, p_camera=None, p_target=None):
     """The perception stage's description of a library object alone on a table, from its depth
-    image ray cast (640×480, 45° vertical field of view) from the default camera's viewpoint."""
+    image ray cast (640×480, 45° vertical field of view) from the default camera's viewpoint
+    (or from `p_camera` looking at `p_target` [m], both from the object's table point)."""
     import open3d as o3d
 
     from tg_drake.objects import get_object, mesh
@@ -146,7 +147,8 @@ def perceive(object_id: str, pose: str, yaw_deg: float):
 
     obj = get_object(object_id)
     intrinsics = Intrinsics.from_fov(640, 480, np.deg2rad(45.0))
-    X_WC = look_at(np.array(P_CAMERA), np.array(P_TARGET))
+    X_WC = look_at(np.array(P_CAMERA if p_camera is None else p_camera, dtype=float),
+                   np.array(P_TARGET if p_target is None else p_target, dtype=float))
     c, s = np.cos(np.deg2rad(yaw_deg)), np.sin(np.deg2rad(yaw_deg))
     X_WO = np.eye(4)
     X_WO[:2, :2] = [[c, -s], [s, c]]
