@@ -10,12 +10,8 @@ episode script as the collection):
   centre). No feature of local shape at the perception's 4 mm resolution can tell these poses
   apart, so how often their labels differ bounds what any classifier of it can reach.
 
-If a grasp's label is a coin that lands "success" with probability p under such tiny changes,
-the best any classifier can do on it is max(p, 1 − p), and two draws agree with probability
-a = p² + (1 − p)². With ā the mean agreement of the original label with the nudged ones
-(weighted to the data set's mix of categories and labels), the attainable accuracy lies between
-ā and (1 + √(2ā − 1)) / 2 (Jensen: each grasp's max(p, 1 − p) = (1 + √(2a − 1)) / 2 is concave
-in a). That interval is reported as the ceiling.
+The ceiling of any classifier on these labels follows from the agreement of the recorded label
+with the nudged ones (`tg_drake.grasping.repeatability`).
 
 Jobs go through the executor interface (JSON Lines, resumable); the analysis is printed and, with
 --results, merged into docs/results/dgi.json under "label_repeatability".
@@ -38,8 +34,8 @@ import numpy as np
 
 from tg_drake.errors import GraspingError
 from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
-from tg_drake.grasping.dgi import PAD_CENTER_Y
 from tg_drake.grasping.episode import EpisodeConfig, run_grasp_batch
+from tg_drake.grasping.repeatability import analyse, nudge, stratified_sample, stratum_weights
 from tg_drake.objects import get_object
 
 
@@ -47,37 +43,15 @@ def category(object_id: str) -> str:
     return get_object(object_id).category
 
 
-def stratified_sample(records: list[dict], per_stratum: int, rng: np.random.Generator
-                      ) -> list[dict]:
-    """Up to `per_stratum` random "ok" records of every (category, label)."""
-    strata: dict[tuple[str, bool], list[dict]] = defaultdict(list)
-    for r in records:
-        if r.get("status") == "ok":
-            strata[(category(r["object"]), bool(r["success"]))].append(r)
-    sample = []
-    for key in sorted(strata):
-        rows = strata[key]
-        pick = rng.choice(len(rows), size=min(per_stratum, len(rows)), replace=False)
-        sample.extend(rows[i] for i in sorted(pick))
-    return sample
+def stratum(record: dict) -> tuple[str, bool]:
+    """The sample's strata: object category and recorded label."""
+    return category(record["object"]), bool(record["success"])
 
 
-def nudge(X_WG: np.ndarray, rng: np.random.Generator, *, distance: float, angle: float
-          ) -> np.ndarray:
-    """X_WG turned by `angle` [rad] about a random axis through its grasp point, which moves by
-    `distance` [m] in a random direction."""
-    from scipy.spatial.transform import Rotation
-
-    axis = rng.normal(size=3)
-    axis /= np.linalg.norm(axis)
-    shift = rng.normal(size=3)
-    shift *= distance / np.linalg.norm(shift)
-    R = Rotation.from_rotvec(angle * axis).as_matrix() @ X_WG[:3, :3]
-    grasp_point = X_WG[:3, 3] + PAD_CENTER_Y * X_WG[:3, 1] + shift
-    X = np.eye(4)
-    X[:3, :3] = R
-    X[:3, 3] = grasp_point - PAD_CENTER_Y * R[:, 1]
-    return X
+def groups(row: dict) -> list[str]:
+    """The groups a re-executed grasp is reported in."""
+    return [f"kind/{row['kind']}", f"category/{category(row['object'])}",
+            f"label/{'positive' if row['original_success'] else 'negative'}"]
 
 
 def make_jobs(sample: list[dict], *, nudges: int, distance: float, angle: float, seed: int,
@@ -111,87 +85,6 @@ def make_jobs(sample: list[dict], *, nudges: int, distance: float, angle: float,
     return jobs
 
 
-def _ceiling(agreement: float) -> list[float]:
-    return [agreement, (1 + np.sqrt(max(2 * agreement - 1, 0.0))) / 2]
-
-
-def stratum_weights(records: list[dict], sample: list[dict]) -> dict[tuple[str, int], float]:
-    """(job, index) of each sampled grasp → its stratum's share of the data over its share of the
-    sample, so that weighted means over the sample estimate means over the whole data set."""
-    def stratum(r):
-        return category(r["object"]), bool(r["success"])
-
-    population = defaultdict(int)
-    for r in records:
-        if r.get("status") == "ok":
-            population[stratum(r)] += 1
-    sampled = defaultdict(int)
-    for r in sample:
-        sampled[stratum(r)] += 1
-    return {(r["job"], r["index"]): population[stratum(r)] / sampled[stratum(r)] for r in sample}
-
-
-def analyse(rows: list[dict], weights: dict[tuple[str, int], float] | None = None) -> dict:
-    """Repeat rates of the labels (see the module docstring). With `weights` (per source grasp,
-    `stratum_weights`) the headline rates and the ceiling are weighted to the data set's mix of
-    categories and labels; the per-group rates are plain means over the sample."""
-    ok = [r for r in rows if r.get("status") == "ok"]
-    errors = [r for r in rows if r.get("status") != "ok"]
-    by_grasp: dict[tuple[str, int], dict] = defaultdict(dict)
-    for r in ok:
-        by_grasp[(r["source_job"], r["source_index"])][r["trial"]] = r
-    exact, nudged, all_agree, w_nudged = [], [], [], []
-    groups: dict[str, dict[str, list]] = defaultdict(lambda: defaultdict(list))
-    flips = []
-    for trials in by_grasp.values():
-        first = next(iter(trials.values()))
-        original = first["original_success"]
-        if "exact" in trials:
-            exact.append(trials["exact"]["success"] == original)
-        agree = [t["success"] == original for name, t in trials.items() if name != "exact"]
-        nudged.extend(agree)
-        w = weights.get((first["source_job"], first["source_index"]), 1.0) if weights else 1.0
-        w_nudged.extend((w, a) for a in agree)
-        if agree:
-            all_agree.append(all(agree))
-        for key in (f"kind/{first['kind']}", f"category/{category(first['object'])}",
-                    f"label/{'positive' if original else 'negative'}"):
-            groups[key]["nudged"].extend(agree)
-        for name, t in trials.items():
-            if t["success"] != original:
-                flips.append({"trial": name, "original_success": original,
-                              "finger_gap": t["finger_gap"], "object_rise": t["object_rise"],
-                              "touches_table": t["touches_table"]})
-    a = float(np.mean(nudged)) if nudged else float("nan")
-    w_a = (float(np.average([a for _, a in w_nudged], weights=[w for w, _ in w_nudged]))
-           if w_nudged else float("nan"))
-    result = {
-        "n_grasps": len(by_grasp),
-        "n_episodes": len(rows),
-        "n_sim_error": len(errors),
-        "exact_repeat_rate": float(np.mean(exact)) if exact else None,
-        "nudged_agreement_sample": a,
-        "nudged_agreement": w_a,  # weighted to the data set's categories and labels
-        "nudged_all_agree": float(np.mean(all_agree)) if all_agree else None,
-        "accuracy_ceiling_interval": _ceiling(w_a),
-        "by_group": {k: {"n": len(v["nudged"]), "nudged_agreement": float(np.mean(v["nudged"]))}
-                     for k, v in sorted(groups.items()) if v["nudged"]},
-    }
-    # Why labels flip: a flip to failure that kept the object in the fingers but on the table
-    # (lifted too little) is a different defect from one that lost it.
-    reasons = defaultdict(int)
-    for f in flips:
-        if f["original_success"]:
-            if f["touches_table"] and f["finger_gap"] > 0.002:
-                reasons["to failure: still in the fingers, touching the table"] += 1
-            else:
-                reasons["to failure: fingers closed on nothing / lost it"] += 1
-        else:
-            reasons["to success"] += 1
-    result["flips"] = dict(reasons)
-    return result
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--data", type=Path, default=Path("data/dgi/grasps.jsonl"))
@@ -214,7 +107,8 @@ def main(argv=None) -> int:
         raise GraspingError("no grasp records; collect them with tools/collect_grasps.py",
                         file=str(args.data))
     records = [json.loads(line) for line in args.data.read_text().splitlines() if line.strip()]
-    sample = stratified_sample(records, args.per_stratum, np.random.default_rng(args.seed))
+    sample = stratified_sample(records, args.per_stratum, np.random.default_rng(args.seed),
+                               stratum)
     jobs = make_jobs(sample, nudges=args.nudges, distance=args.nudge_mm / 1000,
                      angle=np.radians(args.nudge_deg), seed=args.seed, batch=args.batch)
     print(f"{len(sample)} grasps, {sum(len(j.payload['grasps']) for j in jobs)} episodes in "
@@ -224,7 +118,8 @@ def main(argv=None) -> int:
              executor=make_executor(args.executor, workers=args.workers, address=args.address))
     keys = {j.key for j in jobs}
     rows = [json.loads(line) for line in args.out.read_text().splitlines() if line.strip()]
-    result = analyse([r for r in rows if r["job"] in keys], stratum_weights(records, sample))
+    result = analyse([r for r in rows if r["job"] in keys], groups=groups,
+                     weights=stratum_weights(records, sample, stratum))
     result.update(per_stratum=args.per_stratum, nudges=args.nudges, nudge_mm=args.nudge_mm,
                   nudge_deg=args.nudge_deg, wall_seconds=time.perf_counter() - start,
                   command="nice -n 10 .venv/bin/python tools/label_noise.py " + " ".join(
