@@ -19,6 +19,7 @@ computes DGI features, then (paper section V-C):
    "label_repeatability" entry that tools/label_noise.py merged into dgi.json is kept and reported.
 
     nice -n 10 .venv/bin/python tools/train_dgi.py --data data/dgi/grasps.jsonl
+    .venv/bin/python tools/train_dgi.py --markdown-only   # dgi.md from dgi.json
 """
 
 from __future__ import annotations
@@ -154,7 +155,13 @@ def main(argv=None) -> int:
     parser.add_argument("--model-out", type=Path,
                         default=Path(str(files("tg_drake"))) / "data" / "dgi_svm.joblib")
     parser.add_argument("--results", type=Path, default=Path("docs/results"))
+    parser.add_argument("--markdown-only", action="store_true",
+                        help="only write dgi.md again from dgi.json (after tools/label_noise.py)")
     args = parser.parse_args(argv)
+    if args.markdown_only:
+        results = json.loads((args.results / "dgi.json").read_text())
+        (args.results / "dgi.md").write_text(markdown(results))
+        return 0
     start = time.perf_counter()
 
     records = [json.loads(line) for line in args.data.read_text().splitlines() if line.strip()]
@@ -315,12 +322,16 @@ def markdown(r: dict) -> str:
     lines += repeatability_markdown(r.get("label_repeatability"))
     lines += [
         "",
-        "Regenerate (data, then model and these tables):",
+        "Regenerate (data, model and these tables, then the repeatability study and this page):",
         "",
         "```",
         "nice -n 10 .venv/bin/python tools/collect_grasps.py --out data/dgi/grasps.jsonl "
         "--workers 1 --summary docs/results/dgi_dataset_summary.json",
         r["command"],
+        (r.get("label_repeatability") or {}).get(
+            "command", "nice -n 10 .venv/bin/python tools/label_noise.py "
+            "--results docs/results/dgi.json"),
+        ".venv/bin/python tools/train_dgi.py --markdown-only",
         "```",
         "",
     ]
