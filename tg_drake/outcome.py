@@ -75,10 +75,17 @@ def touches_table(plant, plant_context, *, object_body, table_instance) -> bool:
     return any((a in obj and b in table) or (b in obj and a in table) for a, b in pairs)
 
 
-def placed(X_WO_picked, X_WO_now, p_W_target_xy, *, released: bool) -> tuple[bool, str]:
+def placed(X_WO_picked, X_WO_now, p_W_target_xy, *, released: bool,
+           p_OC=(0.0, 0.0, 0.0)) -> tuple[bool, str]:
     """Is the object standing at the place target, in the pose it was picked in, and let go
-    (resting on the table with the gripper open)?"""
-    xy_error = float(np.linalg.norm(X_WO_now.translation()[:2] - np.asarray(p_W_target_xy)))
+    (resting on the table with the gripper open)?
+
+    The place target is where the planner puts the centre of the object's box (what perception
+    sees), so the distance is measured from the true box centre `p_OC` (in the object frame O; a
+    library object's frame origin sits at its base, half a length away from the centre when it
+    lies on its side)."""
+    p_WC = X_WO_now.multiply(np.asarray(p_OC, float))
+    xy_error = float(np.linalg.norm(p_WC[:2] - np.asarray(p_W_target_xy)))
     z_before = X_WO_picked.rotation().col(2)
     z_now = X_WO_now.rotation().col(2)
     tilt = float(np.arccos(np.clip(np.dot(z_before, z_now), -1.0, 1.0)))

@@ -9,6 +9,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource
 
+from tg_drake.planning.planner import PlannerConfig
 from tg_drake.systems.grasp_planner import GraspPlanner, PlanStatus
 from tg_drake.types import (PART_LABELS, GraspCandidates, ObjectDescription, PartBox,
                             SceneDescription)
@@ -119,7 +120,9 @@ def test_follows_the_plan_after_the_planning_event(reachable_run):
         np.testing.assert_allclose(x[7:], plan.v(t - START), atol=1e-12)
         assert planner.get_wsg_position_output_port().Eval(context)[0] == pytest.approx(
             plan.width(t - START), abs=1e-12)
-    assert planner.get_wsg_position_output_port().Eval(context)[0] == 0.0  # closed, lifting
+    # Closed and squeezing (commanded past closed, so the grip is the force limit), lifting.
+    assert planner.get_wsg_position_output_port().Eval(context)[0] == PlannerConfig().closed_width
+    assert PlannerConfig().closed_width < 0.0
     simulator.AdvanceTo(START + plan.duration + 0.1)
     assert status(planner, context).status == "done"
     np.testing.assert_allclose(desired(planner, context)[7:], 0.0, atol=1e-12)

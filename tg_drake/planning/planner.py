@@ -63,8 +63,14 @@ class PlannerConfig:
     retreat_distance: float = 0.10  # [m] after release, back along −y_G.
     release_height: float = 0.01  # [m] gap under the object's box at the place pose.
     open_width: float = 0.11  # [m] WSG opening while moving (its full stroke).
-    closed_width: float = 0.0  # [m] commanded to grasp: the driver's force limit stops the
-    # fingers on the object, so the grip force is the WSG driver's `force_limit`.
+    closed_width: float = -0.04  # [m] commanded to grasp, past closed: each finger's P term
+    # (kp 2000 N/m × (w/2 + 20 mm) on an object w wide) grips with 40 N + 1000 N/m · w, up to the
+    # WSG driver's force limit (80 N from w = 40 mm). Commanding 0 gave a 25 mm hammer handle only
+    # 25 N and the hammer turned out of the pads while carried; a full 80 N on a 20 mm spatula
+    # handle squeezed it out of the pads.
+    squeeze_duration: float = 0.1  # [s] 0 → closed_width, after the fingers have closed
+    # slowly (open → 0 over close_duration) so that they meet a light object gently; and back
+    # closed_width → 0 at release, before opening over open_duration.
     width_margin: float = 0.01  # [m] a part must be this much narrower than the opening.
     close_duration: float = 0.8  # [s] opening → closed command ramp (scripted.py's timing).
     settle_duration: float = 0.4  # [s] hold after closing, before lifting.
@@ -554,14 +560,15 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
     add_motion("carry")
     add_motion("descend")
     t_open = t
-    add_hold(q["place"], c.open_duration)
+    add_hold(q["place"], c.squeeze_duration + c.open_duration)
     t_place_done = t
     add_motion("retreat")
     q_traj = CompositeTrajectory(pieces)
     width_traj = PiecewisePolynomial.FirstOrderHold(
-        [0.0, t_close, t_close + c.close_duration, t_open, t_open + c.open_duration, t],
-        np.array([[c.open_width, c.open_width, c.closed_width, c.closed_width, c.open_width,
-                   c.open_width]]))
+        [0.0, t_close, t_close + c.close_duration, t_close + c.close_duration + c.squeeze_duration,
+         t_open, t_open + c.squeeze_duration, t_open + c.squeeze_duration + c.open_duration, t],
+        np.array([[c.open_width, c.open_width, 0.0, c.closed_width, c.closed_width, 0.0,
+                   c.open_width, c.open_width]]))
     plan = Plan(q_traj=q_traj, v_traj=q_traj.MakeDerivative(), width_traj=width_traj,
                 t_grasp_closed=t_grasp_closed, t_lift_done=t_lift_done,
                 t_place_done=t_place_done, duration=t, candidate=candidate, part=part,
