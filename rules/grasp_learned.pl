@@ -1,5 +1,5 @@
 % LEARNED grasp model: the probabilities of grasp_specific.pl fitted by ProbLog's learning from interpretations (EM, 2 iterations, log-likelihood -124.29),
-% starting from the hand-written values; data: 15 executed grasps of 15 scenes of the training objects (data/learning/grasps.jsonl), 26 interpretations (a grasp that served an afforded task), 1 dropped (no rule for the served part).
+% starting from the hand-written values (worth 2 interpretations as a prior); data: 15 executed grasps of 15 scenes of the training objects (data/learning/grasps.jsonl), 26 interpretations (a grasp that served an afforded task), 1 dropped (no rule for the served part).
 % Made by: python tools/learn_theory.py --stage fit
 % Clauses without data keep their hand-written values. Do not edit: rerun the command (tg_drake/logic/learning.py says what is tunable and why).
 %
@@ -16,13 +16,13 @@
 0.1::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), full(X), part(top, X).
 0.1::grasp(X, T, handle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), full(X), part(handle, X).
 % pass, upright, empty (paper)
-0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(bottom, X).
-0.5::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(middle, X).
-0.5::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(top, X).
+0.0222::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(bottom, X).
+0.5222::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(middle, X).
+0.4333::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(top, X).
 % pass, upside down (paper)
-0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upsidedown), part(bottom, X).
-1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upsidedown), part(middle, X).
-0.0::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upsidedown), part(top, X).
+0.0571::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upsidedown), part(bottom, X).
+0.9143::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upsidedown), part(middle, X).
+0.0286::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upsidedown), part(top, X).
 % pass, sideways (ours)
 0.7::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, sideways), part(middle, X).
 0.2::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, sideways), part(bottom, X).
@@ -35,20 +35,20 @@
 0.7::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, sideways), part(middle, X).
 0.3::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, sideways), part(bottom, X).
 % p&pIn, upright (ours)
-1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upright), part(middle, X).
-0.0::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upright), part(top, X).
+0.9333::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upright), part(middle, X).
+0.0667::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upright), part(top, X).
 % p&pIn, upside down (ours)
-1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upsidedown), part(middle, X).
-0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upsidedown), part(bottom, X).
+0.9143::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upsidedown), part(middle, X).
+0.0857::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, dish), pose(X, upsidedown), part(bottom, X).
 % p&pOn, upright (ours)
-0.5::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upright), part(middle, X).
-0.5::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upright), part(top, X).
+0.5222::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upright), part(middle, X).
+0.4778::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upright), part(top, X).
 % p&pOn, sideways (ours)
 0.7::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, sideways), part(middle, X).
 0.3::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, sideways), part(bottom, X).
 % p&pOn, upside down (ours)
-1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upsidedown), part(middle, X).
-0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upsidedown), part(bottom, X).
+0.8857::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upsidedown), part(middle, X).
+0.1143::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, dish), pose(X, upsidedown), part(bottom, X).
 
 % ---- kitchen_container (pan, pot): held by the handle (ours) ----
 % pass, upright, empty
@@ -88,38 +88,38 @@
 
 % ---- canister (bottle, can): held round the body (ours) ----
 % pass, upright
-0.3333::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upright), part(middle, X).
-0.6667::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upright), part(top, X).
-0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upright), part(bottom, X).
+0.3897::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upright), part(middle, X).
+0.5949::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upright), part(top, X).
+0.0154::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upright), part(bottom, X).
 % pass, sideways
 0.8::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, sideways), part(middle, X).
 0.1::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, sideways), part(top, X).
 0.1::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, sideways), part(bottom, X).
 % pass, upside down
-0.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upsidedown), part(middle, X).
-1.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upsidedown), part(bottom, X).
-0.0::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upsidedown), part(top, X).
+0.28::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upsidedown), part(middle, X).
+0.68::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upsidedown), part(bottom, X).
+0.04::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, canister), pose(X, upsidedown), part(top, X).
 % pourOut, full
-1.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pour_out), kind(X, canister), full(X), part(middle, X).
-0.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pour_out), kind(X, canister), full(X), part(bottom, X).
+0.96::grasp(X, T, middle) :- affords(X, T), isa_task(T, pour_out), kind(X, canister), full(X), part(middle, X).
+0.04::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pour_out), kind(X, canister), full(X), part(bottom, X).
 % p&pIn, upright
-0.5::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upright), part(middle, X).
-0.5::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upright), part(top, X).
+0.5154::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upright), part(middle, X).
+0.4846::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upright), part(top, X).
 % p&pIn, sideways
 0.8::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, sideways), part(middle, X).
 0.2::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, sideways), part(bottom, X).
 % p&pIn, upside down
-0.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upsidedown), part(middle, X).
-1.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upsidedown), part(bottom, X).
+0.24::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upsidedown), part(middle, X).
+0.76::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_in), kind(X, canister), pose(X, upsidedown), part(bottom, X).
 % p&pOn, upright
-0.3333::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upright), part(middle, X).
-0.6667::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upright), part(top, X).
+0.3744::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upright), part(middle, X).
+0.6256::grasp(X, T, top) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upright), part(top, X).
 % p&pOn, sideways
 0.8::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, sideways), part(middle, X).
 0.2::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, sideways), part(bottom, X).
 % p&pOn, upside down
-0.0::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upsidedown), part(middle, X).
-1.0::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upsidedown), part(bottom, X).
+0.24::grasp(X, T, middle) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upsidedown), part(middle, X).
+0.76::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pp_on), kind(X, canister), pose(X, upsidedown), part(bottom, X).
 
 % ---- tool (hammer, knife, screwdriver, cooking_tool) ----
 % pass: by the usable area, the receiver takes the handle (paper, IV)

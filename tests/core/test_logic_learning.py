@@ -35,18 +35,18 @@ TOLERANCE = 0.075
 # A known small grasp model: one block (dish, pass, upright, empty) and one tool block. The
 # file the fit starts from has other values (0.5 everywhere), as hand-written guesses would.
 TRUE_GRASP = {"middle": 0.7, "top": 0.25, "bottom": 0.1, "usable_area": 0.85, "handle": 0.3}
-GRASP_FILE = """% A small grasp model for the learning test.
-{middle}::grasp(X, T, middle) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(middle, X).
-{top}::grasp(X, T, top) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(top, X).
-{bottom}::grasp(X, T, bottom) :- affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X), part(bottom, X).
-{usable_area}::grasp(X, T, usable_area) :- affords(X, T), isa_task(T, pass), kind(X, tool), part(usable_area, X).
-{handle}::grasp(X, T, handle) :- affords(X, T), isa_task(T, pass), kind(X, tool), part(handle, X).
-"""
+DISH_PASS = "affords(X, T), isa_task(T, pass), kind(X, dish), pose(X, upright), empty(X)"
+TOOL_PASS = "affords(X, T), isa_task(T, pass), kind(X, tool)"
+GRASP_FILE = "% A small grasp model for the learning test.\n" + "".join(
+    f"{{{part}}}::grasp(X, T, {part}) :-\n    {body}, part({part}, X).\n"
+    for part, body in (("middle", DISH_PASS), ("top", DISH_PASS), ("bottom", DISH_PASS),
+                       ("usable_area", TOOL_PASS), ("handle", TOOL_PASS)))
 # A known annotated disjunction of the category model: glass, bowl, or some canister (which the
 # fixed spread makes a can or a bottle, half each).
 TRUE_CATEGORY = {"glass": 0.2, "bowl": 0.3, "canister": 0.5}
 CATEGORY_FILE = """% A small category model for the learning test.
-{glass}::cat(X, glass); {bowl}::cat(X, bowl); {canister}::some(X, canister) :- tmb(X), no_handle(X), pose(X, upright).
+{glass}::cat(X, glass); {bowl}::cat(X, bowl); {canister}::some(X, canister) :-
+    tmb(X), no_handle(X), pose(X, upright).
 """
 
 
@@ -55,7 +55,8 @@ def small_rules(tmp_path) -> Path:
     for name in ("object_ontology.pl", "task_ontology.pl", "observations.pl", "affordances.pl",
                  "category_spread.pl"):
         shutil.copy(rules_dir() / name, tmp_path / name)
-    (tmp_path / "grasp_specific.pl").write_text(GRASP_FILE.format(**{k: 0.5 for k in TRUE_GRASP}))
+    (tmp_path / "grasp_specific.pl").write_text(
+        GRASP_FILE.format(**{k: 0.5 for k in TRUE_GRASP}))
     (tmp_path / "category_specific.pl").write_text(
         CATEGORY_FILE.format(glass=0.3, bowl=0.3, canister=0.4))
     return tmp_path
@@ -79,7 +80,8 @@ def _grasp_samples(rng) -> list[Interpretation]:
 def test_grasp_probabilities_are_recovered(small_rules):
     data = _grasp_samples(np.random.default_rng(0))
     result = fit(data, model="grasp", directory=small_rules)
-    learned = {c.text.split("grasp(X, T, ")[1].split(")")[0]: c.after[0] for c in result.clauses}
+    learned = {c.text.split("grasp(X, T, ")[1].split(")")[0]: c.after[0]
+               for c in result.clauses}
     assert set(learned) == set(TRUE_GRASP)
     for part, p in TRUE_GRASP.items():
         assert abs(learned[part] - p) < TOLERANCE, (part, learned[part], p)
@@ -211,10 +213,11 @@ def test_query_with_the_learned_theory(capsys):
 
 
 def test_pipeline_accepts_the_learned_theory_and_checks_grasp_part():
-    from tg_drake.errors import ScenarioError
-    from tg_drake.scenario import PipelineConfig
-    from tg_drake.run import add_arguments
     import argparse
+
+    from tg_drake.errors import ScenarioError
+    from tg_drake.run import add_arguments
+    from tg_drake.scenario import PipelineConfig
 
     PipelineConfig(category_theory="learned", grasp_theory="learned", grasp_part="handle"
                    ).validate()

@@ -475,9 +475,19 @@ def fit(interpretations: Sequence[Interpretation], *, model: str = "grasp",
             after = [(n * a + prior_strength * b) / (n + prior_strength)
                      for a, b in zip(mle, before)]
         clauses.append(LearnedClause(source_clause.file, source_clause.line, source_clause.text,
-                                     before, [round(a, 4) for a in after], n))
+                                     before, _rounded(after), n))
     return FitResult(model, variant, clauses, log_likelihood, int(lfi.iteration), len(kept),
                      dropped)
+
+
+def _rounded(p: list[float], digits: int = 4) -> list[float]:
+    """Rounded for the file, the heads of a disjunction still summing to at most 1."""
+    out = [round(x, digits) for x in p]
+    excess = round(sum(out) - 1.0, digits)
+    if excess > 0:
+        i = max(range(len(out)), key=out.__getitem__)
+        out[i] = round(out[i] - excess, digits)
+    return out
 
 
 def _weight(w) -> float:
