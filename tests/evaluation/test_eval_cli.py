@@ -110,6 +110,8 @@ def test_the_same_sweep_runs_on_a_local_ray_instance(tiny_run, tmp_path):
     local = {r["job"]: r for r in lines(tiny_run / "results.jsonl")}
     remote = {r["job"]: r for r in lines(tmp_path / "results.jsonl")}
     assert remote.keys() == local.keys()
+    assert all("methods" in r for r in remote.values()), [r.get("reason") for r in
+                                                          remote.values()]
     for key, r in remote.items():  # the same answers: seeded per case, not per worker
         assert r["methods"] == local[key]["methods"] and r["priors"] == local[key]["priors"]
 
