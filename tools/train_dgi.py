@@ -111,22 +111,44 @@ def object_factors(object_ids: np.ndarray) -> np.ndarray:
     return 3.0 * np.column_stack([category, log_mass])
 
 
-def nonlocal_accuracy(X, y, object_ids, scenes, gamma, C, folds: dict) -> dict:
-    """What the object's identity, mass and category explain, beside local shape.
+def pose_context(X_WG: np.ndarray, centroids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per grasp, what the gripper pose and the whole cloud know beyond local shape, weighted 2
+    to 1 against a DGI pixel: gravity's direction in the gripper frame G (the DGI, taken in G,
+    is blind to it; the paper's camera images of objects on a table were not), and the offset
+    from the grasp point to the cloud's centroid in G, per 10 cm (a lever arm, where the centre
+    of mass may lie)."""
+    from tg_drake.grasping.dgi import PAD_CENTER_Y
+
+    R_WG = X_WG[:, :3, :3]
+    gravity_G = -R_WG[:, 2, :]  # R_GW · (0, 0, −1)
+    grasp_point = X_WG[:, :3, 3] + PAD_CENTER_Y * X_WG[:, :3, 1]
+    offset_G = np.einsum("mij,mi->mj", R_WG, centroids - grasp_point)
+    return 2.0 * gravity_G, 2.0 * offset_G / 0.1
+
+
+def nonlocal_accuracy(X, y, data, gamma, C, folds: dict) -> dict:
+    """What the object's identity, mass and category, and the grasp's pose explain, beside local
+    shape.
 
     - `object_majority`: every grasp predicted as the majority label of its object's other grasps
       (folds not by object): the best any rule that sees only which object it is can do;
     - `mass_category`: a logistic regression of the category and log mass alone;
-    - `dgi_mass_category`: the RBF SVM on the DGI plus those.
+    - `dgi_mass_category`: the RBF SVM on the DGI plus those;
+    - `dgi_gravity`, `dgi_gravity_centroid`: the RBF SVM on the DGI plus `pose_context`.
     """
     from sklearn.linear_model import LogisticRegression
 
+    object_ids, scenes = data.object_ids, data.scenes
     F = object_factors(object_ids)
+    gravity, offset = pose_context(data.X_WG, data.centroids)
+    extended = {"dgi_mass_category": np.hstack([X, F]),
+                "dgi_gravity": np.hstack([X, gravity]),
+                "dgi_gravity_centroid": np.hstack([X, gravity, offset])}
     out = {}
     for name, fold in folds.items():
         majority = np.empty(len(y))
         p_mc = np.empty(len(y))
-        p_dmc = np.empty(len(y))
+        f = {key: np.empty(len(y)) for key in extended}
         for train, test in fold:
             for obj in np.unique(object_ids[test]):
                 seen = y[train][object_ids[train] == obj]
@@ -134,13 +156,13 @@ def nonlocal_accuracy(X, y, object_ids, scenes, gamma, C, folds: dict) -> dict:
                                                            else np.nan)
             p_mc[test] = LogisticRegression(max_iter=1000).fit(F[train], y[train]).predict(
                 F[test])
-            both = np.hstack([X, F])
-            svm = SVC(kernel="rbf", gamma=gamma, C=C).fit(both[train], y[train])
-            f = svm.decision_function(both[test])
-            p_dmc[test] = f
-        entry = {"mass_category": float(np.mean(p_mc == y)),
-                 "dgi_mass_category": float(np.mean((p_dmc > 0) == y)),
-                 "dgi_mass_category_top_grasp": top_grasp_accuracy(p_dmc, y, scenes)["accuracy"]}
+            for key, Z in extended.items():
+                svm = SVC(kernel="rbf", gamma=gamma, C=C).fit(Z[train], y[train])
+                f[key][test] = svm.decision_function(Z[test])
+        entry = {"mass_category": float(np.mean(p_mc == y))}
+        for key, values in f.items():
+            entry[key] = float(np.mean((values > 0) == y))
+            entry[f"{key}_top_grasp"] = top_grasp_accuracy(values, y, scenes)["accuracy"]
         known = ~np.isnan(majority)  # objects whose every grasp is in the test fold: no rule
         if known.mean() > 0.5:
             entry["object_majority"] = float(np.mean(majority[known] == y[known]))
@@ -160,6 +182,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if args.markdown_only:
         results = json.loads((args.results / "dgi.json").read_text())
+        variants = args.results / "dgi_variants.json"
+        if variants.is_file():
+            results["variants"] = json.loads(variants.read_text())
         (args.results / "dgi.md").write_text(markdown(results))
         return 0
     start = time.perf_counter()
@@ -191,7 +216,7 @@ def main(argv=None) -> int:
           f"top grasp {top['accuracy']:.4f}", flush=True)
 
     # 4. what mass and category explain.
-    nonlocal_ = nonlocal_accuracy(X, y, data.object_ids, data.scenes, gamma, C,
+    nonlocal_ = nonlocal_accuracy(X, y, data, gamma, C,
                                   {"stratified": list(stratified.split(X, y)),
                                    "objectwise": objectwise})
     print(json.dumps(nonlocal_), flush=True)
@@ -248,6 +273,9 @@ def main(argv=None) -> int:
         kept = json.loads(previous.read_text()).get("label_repeatability")
         if kept:
             results["label_repeatability"] = kept
+    variants = args.results / "dgi_variants.json"  # tools/dgi_variants.py, if it was run.
+    if variants.is_file():
+        results["variants"] = json.loads(variants.read_text())
     (args.results / "dgi.json").write_text(json.dumps(results, indent=1) + "\n")
     (args.results / "dgi.md").write_text(markdown(results))
     print(json.dumps({k: v for k, v in results.items() if not isinstance(v, dict)}, indent=1))
@@ -318,6 +346,7 @@ def markdown(r: dict) -> str:
     lines += ["", "| category | accuracy on unseen objects |", "|---|---|"]
     for c, a in r["objectwise_accuracy_per_category"].items():
         lines.append(f"| {c} | {100 * a:.1f} % |")
+    lines += variants_markdown(r.get("variants"))
     lines += nonlocal_markdown(r)
     lines += repeatability_markdown(r.get("label_repeatability"))
     lines += [
@@ -338,10 +367,38 @@ def markdown(r: dict) -> str:
     return "\n".join(lines)
 
 
+def variants_markdown(v: dict | None) -> list[str]:
+    """The table of tools/dgi_variants.py (docs/results/dgi_variants.json), if it was run."""
+    if not v:
+        return []
+    lines = [
+        "",
+        "## Feature and SVM variants",
+        "",
+        "γ of each variant chosen by 4-fold stratified cross-validation (C = 1); the variants are",
+        "compared on that accuracy alone, the unseen-object columns are shown, not used to choose.",
+        "",
+        "| variant | features | γ | cross-validated | unseen objects | top grasp (unseen) |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, e in v["variants"].items():
+        lines.append(f"| {name}: {e['description']} | {e['n_features']} | {e['gamma']:g} | "
+                     f"{100 * e['cv_accuracy']:.2f} % | {100 * e['objectwise_accuracy']:.2f} % | "
+                     f"{100 * e['top_grasp_accuracy']:.2f} % |")
+    lines += ["", f"Best by cross-validated accuracy: {v['best_by_cv_accuracy']}. "
+              f"`{v['command']}`"]
+    return lines
+
+
 def nonlocal_markdown(r: dict) -> list[str]:
     n = r["nonlocal_factors"]
     s, o = n["stratified"], n["objectwise"]
     nested = ", ".join(f"γ {p['gamma']:g} / C {p['C']:g}" for p in r["objectwise_nested_params"])
+
+    def row(label, key):
+        return (f"| {label} | {100 * s[key]:.1f} % | {100 * o[key]:.1f} % | "
+                f"{100 * o[key + '_top_grasp']:.1f} % |")
+
     return [
         "",
         "## What local shape cannot know",
@@ -351,20 +408,20 @@ def nonlocal_markdown(r: dict) -> list[str]:
         "cannot see. Accuracy of classifiers that see only the object, and of the DGI with it",
         "(same folds as above; the logistic regression and the SVM with the DGI's γ and C):",
         "",
-        "| classifier | folds not by object | folds by object (unseen objects) |",
-        "|---|---|---|",
+        "| classifier | folds not by object | folds by object (unseen objects) | top grasp "
+        "(unseen) |",
+        "|---|---|---|---|",
         f"| always the commoner label | "
-        f"{100 * max(r['n_positive'], r['n_negative']) / r['n_grasps']:.1f} % | – |",
+        f"{100 * max(r['n_positive'], r['n_negative']) / r['n_grasps']:.1f} % | – | – |",
         f"| the object's majority label (its other grasps) | {100 * s['object_majority']:.1f} % "
-        "| – |",
+        "| – | – |",
         f"| mass + category (logistic regression) | {100 * s['mass_category']:.1f} % | "
-        f"{100 * o['mass_category']:.1f} % |",
+        f"{100 * o['mass_category']:.1f} % | – |",
         f"| DGI (the shipped model) | {100 * r['cv_accuracy']:.1f} % | "
-        f"{100 * r['objectwise_cv_accuracy']:.1f} % |",
-        f"| DGI + mass + category (RBF SVM) | {100 * s['dgi_mass_category']:.1f} % | "
-        f"{100 * o['dgi_mass_category']:.1f} % |",
-        f"| top grasp by DGI + mass + category | {100 * s['dgi_mass_category_top_grasp']:.1f} % | "
-        f"{100 * o['dgi_mass_category_top_grasp']:.1f} % |",
+        f"{100 * r['objectwise_cv_accuracy']:.1f} % | {100 * r['top_grasp_accuracy']:.1f} % |",
+        row("DGI + mass + category", "dgi_mass_category"),
+        row("DGI + gravity's direction in the gripper frame", "dgi_gravity"),
+        row("DGI + gravity + offset to the cloud's centroid", "dgi_gravity_centroid"),
         "",
         "The shipped model stays a model of local shape (the paper's P(grasp | local shape); the",
         "logic's P(part | task) carries what is known about the object). In the folds by object,",

@@ -57,3 +57,5 @@ def test_training_set_computes_features_of_ok_records_only(cup):
     p_W, _, _ = scene_cloud(cup, "sideways", seed=0)
     np.testing.assert_array_equal(data.X, dgi_features(p_W, scene.X_WG[:6]))
     assert set(data.scenes) == {"cup_01/sideways"}
+    np.testing.assert_array_equal(data.X_WG, scene.X_WG[:6])
+    np.testing.assert_allclose(data.centroids, np.repeat(p_W.mean(axis=0)[None], 6, axis=0))

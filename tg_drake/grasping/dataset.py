@@ -137,6 +137,8 @@ class TrainingSet:
     scenes: np.ndarray  # (n,) str "object/pose"
     kinds: np.ndarray  # (n,) str
     parts: np.ndarray  # (n,) int
+    X_WG: np.ndarray | None = None  # (n, 4, 4) the grasps' gripper poses.
+    centroids: np.ndarray | None = None  # (n, 3) centroid of the scene's cloud in the world [m].
 
 
 def training_set(records: list[dict], *, seed: int, config: DgiConfig = DgiConfig(),
@@ -146,11 +148,13 @@ def training_set(records: list[dict], *, seed: int, config: DgiConfig = DgiConfi
     by_scene: dict[tuple[str, str], list[dict]] = {}
     for r in ok:
         by_scene.setdefault((r["object"], r["pose"]), []).append(r)
-    X, y, objs, scenes, kinds, parts = [], [], [], [], [], []
+    X, y, objs, scenes, kinds, parts, poses, centroids = [], [], [], [], [], [], [], []
     for (object_id, pose), rows in sorted(by_scene.items()):
         p_W, _, _ = scene_cloud(get_object(object_id), pose, seed=seed, config=sampling)
         X_WG = np.array([r["X_WG"] for r in rows], dtype=float).reshape(-1, 4, 4)
         X.append(dgi_features(p_W, X_WG, config))
+        poses.append(X_WG)
+        centroids.append(np.repeat(p_W.mean(axis=0)[None], len(rows), axis=0))
         y.extend(int(r["success"]) for r in rows)
         objs.extend(object_id for _ in rows)
         scenes.extend(f"{object_id}/{pose}" for _ in rows)
@@ -158,6 +162,8 @@ def training_set(records: list[dict], *, seed: int, config: DgiConfig = DgiConfi
         parts.extend(int(r["part"]) for r in rows)
     if not X:
         return TrainingSet(np.zeros((0, config.n_features)), np.zeros(0, int), np.zeros(0, str),
-                           np.zeros(0, str), np.zeros(0, str), np.zeros(0, int))
+                           np.zeros(0, str), np.zeros(0, str), np.zeros(0, int),
+                           np.zeros((0, 4, 4)), np.zeros((0, 3)))
     return TrainingSet(np.concatenate(X), np.array(y), np.array(objs), np.array(scenes),
-                       np.array(kinds), np.array(parts))
+                       np.array(kinds), np.array(parts), np.concatenate(poses),
+                       np.concatenate(centroids))
