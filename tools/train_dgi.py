@@ -385,8 +385,9 @@ def variants_markdown(v: dict | None) -> list[str]:
         lines.append(f"| {name}: {e['description']} | {e['n_features']} | {e['gamma']:g} | "
                      f"{100 * e['cv_accuracy']:.2f} % | {100 * e['objectwise_accuracy']:.2f} % | "
                      f"{100 * e['top_grasp_accuracy']:.2f} % |")
-    lines += ["", f"Best by cross-validated accuracy: {v['best_by_cv_accuracy']}. "
-              f"`{v['command']}`"]
+    commands = v.get("commands") or [v["command"]]
+    lines += ["", f"Best by cross-validated accuracy: {v['best_by_cv_accuracy']}.", "", "```",
+              *commands, "```"]
     return lines
 
 
