@@ -54,8 +54,27 @@ def groups(row: dict) -> list[str]:
             f"label/{'positive' if row['original_success'] else 'negative'}"]
 
 
+def episode_config(text: str | None) -> EpisodeConfig:
+    """EpisodeConfig with the overrides "field=value,field=value" (floats)."""
+    from dataclasses import fields
+
+    from tg_drake.errors import unknown_name
+
+    names = [f.name for f in fields(EpisodeConfig)]
+    overrides = {}
+    for item in filter(None, (text or "").split(",")):
+        name, _, value = item.partition("=")
+        if name not in names:
+            raise unknown_name("episode setting", name, names, error=GraspingError)
+        try:
+            overrides[name] = float(value)
+        except ValueError:
+            raise GraspingError(f"episode setting {name}: {value!r} is not a number") from None
+    return EpisodeConfig(**overrides)
+
+
 def make_jobs(sample: list[dict], *, nudges: int, distance: float, angle: float, seed: int,
-              batch: int) -> list[Job]:
+              batch: int, episode: EpisodeConfig) -> list[Job]:
     """One batch of re-executions per scene: each sampled grasp exactly once, nudged `nudges`
     times."""
     rng = np.random.default_rng(seed)
@@ -80,7 +99,7 @@ def make_jobs(sample: list[dict], *, nudges: int, distance: float, angle: float,
         for b in range(0, len(grasps), batch):
             jobs.append(Job(f"{object_id}/{pose}/{b // batch}", {
                 "object": object_id, "pose": pose, "object_sdf": str(obj.sdf_path),
-                "X_WO": X_WO.ravel().tolist(), "config": asdict(EpisodeConfig()),
+                "X_WO": X_WO.ravel().tolist(), "config": asdict(episode),
                 "grasps": grasps[b:b + batch]}))
     return jobs
 
@@ -99,9 +118,17 @@ def main(argv=None) -> int:
     parser.add_argument("--executor", choices=EXECUTORS, default="local")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--address", help="Ray cluster address (with --executor ray)")
+    parser.add_argument("--episode", help="episode script changes, e.g. "
+                        "shake_amplitude=0.0075,shake_time=0.6: nudges are then compared with "
+                        "the exact re-execution (the recorded label is of the old script)")
+    parser.add_argument("--key", help="store under label_repeatability_KEY in --results")
     parser.add_argument("--results", type=Path,
                         help="merge the analysis into this JSON file (docs/results/dgi.json)")
     args = parser.parse_args(argv)
+    try:
+        episode = episode_config(args.episode)
+    except GraspingError as e:
+        parser.error(str(e))
 
     if not args.data.is_file():
         raise GraspingError("no grasp records; collect them with tools/collect_grasps.py",
@@ -110,7 +137,8 @@ def main(argv=None) -> int:
     sample = stratified_sample(records, args.per_stratum, np.random.default_rng(args.seed),
                                stratum)
     jobs = make_jobs(sample, nudges=args.nudges, distance=args.nudge_mm / 1000,
-                     angle=np.radians(args.nudge_deg), seed=args.seed, batch=args.batch)
+                     angle=np.radians(args.nudge_deg), seed=args.seed, batch=args.batch,
+                     episode=episode)
     print(f"{len(sample)} grasps, {sum(len(j.payload['grasps']) for j in jobs)} episodes in "
           f"{len(jobs)} jobs", flush=True)
     start = time.perf_counter()
@@ -119,15 +147,16 @@ def main(argv=None) -> int:
     keys = {j.key for j in jobs}
     rows = [json.loads(line) for line in args.out.read_text().splitlines() if line.strip()]
     result = analyse([r for r in rows if r["job"] in keys], groups=groups,
-                     weights=stratum_weights(records, sample, stratum))
-    result.update(per_stratum=args.per_stratum, nudges=args.nudges, nudge_mm=args.nudge_mm,
+                     weights=stratum_weights(records, sample, stratum),
+                     reference="exact" if args.episode else "recorded")
+    result.update(episode=args.episode or "as collected", per_stratum=args.per_stratum, nudges=args.nudges, nudge_mm=args.nudge_mm,
                   nudge_deg=args.nudge_deg, wall_seconds=time.perf_counter() - start,
                   command="nice -n 10 .venv/bin/python tools/label_noise.py " + " ".join(
                       sys.argv[1:] if argv is None else argv))
     print(json.dumps(result, indent=1))
     if args.results:
         existing = json.loads(args.results.read_text()) if args.results.is_file() else {}
-        existing["label_repeatability"] = result
+        existing["label_repeatability" + (f"_{args.key}" if args.key else "")] = result
         args.results.write_text(json.dumps(existing, indent=1) + "\n")
     return 0
 

@@ -103,3 +103,13 @@ def test_analyse_counts_repeats_flips_and_weights():
     assert lo == pytest.approx(weighted["nudged_agreement"]) and hi > lo
     with pytest.raises(GraspingError, match="nothing to analyse"):
         analyse(rows[:1], groups=lambda r: [])
+    # Against the exact re-execution instead of the recorded label: grasp 2's exact run failing
+    # makes its two nudges compare with failure (one agrees), the recorded label no longer counts.
+    changed = [dict(r, success=False) if (r["source_index"], r["trial"]) == (2, "exact") else r
+               for r in rows]
+    assert analyse(changed, groups=lambda r: [])["nudged_agreement"] == pytest.approx(3 / 5)
+    exact = analyse(changed, groups=lambda r: [], reference="exact")
+    assert exact["nudged_agreement"] == pytest.approx((2 + 1 + 0) / 5)
+    assert exact["exact_repeat_rate"] == pytest.approx(2 / 3)
+    with pytest.raises(GraspingError, match="allowed: recorded, exact"):
+        analyse(rows, groups=lambda r: [], reference="first")

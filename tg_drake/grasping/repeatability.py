@@ -20,10 +20,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-from tg_drake.errors import GraspingError
+from tg_drake.errors import GraspingError, unknown_name
 from tg_drake.grasping.dgi import PAD_CENTER_Y
 
 Stratum = Callable[[dict], tuple]
+REFERENCES = ("recorded", "exact")  # which label the nudged ones are compared with
 
 
 def stratified_sample(records: list[dict], per_stratum: int, rng: np.random.Generator,
@@ -87,7 +88,7 @@ def accuracy_ceiling(agreement: float) -> tuple[float, float]:
 
 def analyse(rows: list[dict], *, groups: Callable[[dict], list[str]],
             weights: dict[tuple[str, int], float] | None = None,
-            held_gap: float = 0.002) -> dict:
+            held_gap: float = 0.002, reference: str = "recorded") -> dict:
     """Repeat rates of re-executed grasps.
 
     `rows`: episode records with "source_job", "source_index" (the recorded grasp),
@@ -96,8 +97,12 @@ def analyse(rows: list[dict], *, groups: Callable[[dict], list[str]],
     category, label), reported apart as plain means over the sample; with `weights` (per source
     grasp, `stratum_weights`) the headline agreement and the ceiling are weighted to the data set.
     Flips are sorted by what the re-execution saw (`held_gap`: fingers further apart than this
-    closed on something).
+    closed on something). `reference`: the label the nudged ones are compared with, "recorded"
+    (the data set's) or "exact" (the re-execution with the same pose: for a changed episode
+    script, whose labels the data set does not have); grasps without it are left out.
     """
+    if reference not in REFERENCES:
+        raise unknown_name("reference label", reference, REFERENCES, error=GraspingError)
     ok = [r for r in rows if r.get("status") == "ok"]
     by_grasp: dict[tuple[str, int], dict[str, dict]] = defaultdict(dict)
     for r in ok:
@@ -107,9 +112,14 @@ def analyse(rows: list[dict], *, groups: Callable[[dict], list[str]],
     flips: dict[str, int] = defaultdict(int)
     for key, trials in by_grasp.items():
         first = next(iter(trials.values()))
-        original = bool(first["original_success"])
+        if reference == "exact":
+            if "exact" not in trials:
+                continue
+            original = bool(trials["exact"]["success"])
+        else:
+            original = bool(first["original_success"])
         if "exact" in trials:
-            exact.append(trials["exact"]["success"] == original)
+            exact.append(trials["exact"]["success"] == bool(first["original_success"]))
         agree = [t["success"] == original for name, t in trials.items() if name != "exact"]
         nudged.extend(agree)
         if agree:
