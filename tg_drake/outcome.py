@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# A finger opening below this means the fingers closed on air (the pads' compliance squeezes a
-# held object by at most a few millimetres) [m].
-CLOSED_ON_AIR = 0.004
+# A finger opening below this means the fingers closed on air, whatever touches their outsides
+# (a bowl's wall, 4–5 mm thick, leaves the squeezing pads about 4 mm apart) [m].
+CLOSED_ON_AIR = 0.001
 # Placement tolerances: distance of the object's centre from the place target on the table [m],
 # tilt of its axis from the pose it was picked in [rad].
 PLACE_XY_TOLERANCE = 0.05

@@ -144,3 +144,30 @@ def test_describe_cloud_rejects_bad_input():
         describe_cloud(below, np.eye(4), np.ones(3))
     with pytest.raises(PerceptionError, match="X_WT"):
         describe_cloud(below, np.eye(3), np.ones(3))
+
+
+def test_rim_pregrasps_on_a_wide_upright_top_only():
+    from tg_drake.perception.config import PregraspConfig
+    from tg_drake.perception.pregrasp import rim_pregrasps
+
+    cfg = PregraspConfig()
+    X_WB = make_transform(np.eye(3), [0.7, 0.1, 0.05])  # a bowl's top: 16 cm across, 2 cm high
+    X = rim_pregrasps(X_WB, np.array([0.08, 0.08, 0.01]), cfg)
+    assert X.shape == (cfg.rim_azimuths, 4, 4)
+    R = X[:, :3, :3]
+    np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-9)
+    np.testing.assert_allclose(R[:, :, 1], np.tile([0.0, 0.0, -1.0], (len(X), 1)), atol=1e-12)
+    p_grasp = X[:, :3, 3] + R @ WSG_GRASP_POINT_G
+    radial = p_grasp[:, :2] - [0.7, 0.1]
+    # On the wall (rim_wall inside the outer radius), rim_depth below the rim, fingers closing
+    # radially, spread evenly around the axis.
+    np.testing.assert_allclose(np.linalg.norm(radial, axis=1), 0.08 - cfg.rim_wall, atol=1e-12)
+    np.testing.assert_allclose(p_grasp[:, 2], 0.06 - cfg.rim_depth, atol=1e-12)
+    np.testing.assert_allclose(np.abs(np.einsum("ni,ni->n", R[:, :2, 0], radial)),
+                               0.08 - cfg.rim_wall, atol=1e-12)
+    assert len({round(float(np.arctan2(*r[::-1])), 6) for r in radial}) == cfg.rim_azimuths
+    # A top the gripper spans gets none; nor does a top that does not face up (lying sideways).
+    assert rim_pregrasps(X_WB, np.array([0.04, 0.04, 0.01]), cfg).shape == (0, 4, 4)
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # 90° about x
+    sideways = make_transform(rx, [0.7, 0.1, 0.08])
+    assert rim_pregrasps(sideways, np.array([0.08, 0.08, 0.01]), cfg).shape == (0, 4, 4)

@@ -278,3 +278,31 @@ def test_trajectory_stays_clear_of_collisions(planned):
         # dense check), less 1 mm for the planner's own sample spacing (0.01 rad of a joint).
         assert d >= 0.5 * min_distance - 1e-3, (name, d)
         assert reported >= 0.5 * min_distance
+
+
+def test_a_rim_grasp_needs_only_the_wall_between_the_fingers():
+    """A bowl is wider than the WSG opens, so its top's box rules every grasp out; measured on the
+    perceived points between the pads, a grasp across the wall fits."""
+    from tg_drake.planning.planner import _part_width, _width_between_pads
+
+    angle = np.linspace(0.0, 2.0 * np.pi, 720, endpoint=False)
+    height = np.linspace(0.0, 0.06, 25)
+    ring = np.stack([np.cos(angle), np.sin(angle)], axis=1)
+    # Outer wall radius 0.08 m and inner 0.076 m, 6 cm high, centred at (0.75, 0.1) on the table.
+    p_W = np.concatenate([np.column_stack([0.75 + r * ring[:, 0], 0.1 + r * ring[:, 1],
+                                           np.full(len(ring), z)])
+                          for r in (0.08, 0.076) for z in height])
+    bowl = box_object([0.75, 0.1, 0.03], [0.16, 0.16, 0.06])
+    bowl.p_W = p_W
+    rim = grasp_pose([0.75 + 0.078, 0.1, 0.055], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
+    assert _part_width(bowl, "top", rim) == pytest.approx(0.16)
+    # The inner wall's farthest point under the 2 cm wide pads: 1 cm along the wall, where the
+    # ring has curved away from the grasp point.
+    inner = 0.078 - np.sqrt(0.076 ** 2 - 0.01 ** 2)
+    assert _width_between_pads(bowl, rim) == pytest.approx(2 * inner, abs=5e-4)
+    # Across the middle of the bowl the fingers would land on both walls: no fit, and nothing
+    # between the pads at all far from the bowl.
+    across = grasp_pose([0.75, 0.1, 0.055], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
+    assert _width_between_pads(bowl, across) > PlannerConfig().open_width
+    away = grasp_pose([0.5, -0.2, 0.055], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
+    assert _width_between_pads(bowl, away) == np.inf

@@ -84,6 +84,14 @@ class PregraspConfig:
 
     grasp_depth: float = 0.02  # the grasp point lies this far inside the face [m] (at most
     # half the box depth): the fingers straddle the part's outer layer.
+    # Rim grasps (ours, beyond the paper's box faces): an open container whose top part is wider
+    # than the gripper opens (a bowl, a pot) can still be taken by its wall, one finger inside.
+    rim_min_width: float = 0.10  # a top part at least this wide both ways gets rim grasps [m].
+    rim_azimuths: int = 8  # rim grasps spread evenly around the axis.
+    rim_depth: float = 0.005  # the grasp point lies this far below the rim [m]: the inner
+    # finger stays high, clear of the container's floor.
+    rim_wall: float = 0.004  # the grasp point lies this far inside the outer radius [m] (about
+    # half a wall's thickness).
 
 
 @dataclass

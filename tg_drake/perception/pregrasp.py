@@ -1,4 +1,6 @@
-"""Pre-grasp hypotheses: two gripper poses per face of each part's bounding box (paper III-B).
+"""Pre-grasp hypotheses: two gripper poses per face of each part's bounding box (paper III-B),
+and rim grasps on the wide top of an upright open container (ours: a bowl is wider than the WSG
+opens, so no box-face grasp fits it).
 
 For the face of a part box with outward normal f, the gripper approaches along −f; the two poses
 close the fingers along one or the other of the face's two edge directions. The grasp point (the
@@ -59,14 +61,49 @@ def box_pregrasps(X_WB: np.ndarray, half_extents: np.ndarray,
     return X
 
 
+def rim_pregrasps(X_WB: np.ndarray, half_extents: np.ndarray,
+                  cfg: PregraspConfig | None = None) -> np.ndarray:
+    """Rim grasps on the top part box of an upright open container: (K, 4, 4) X_WG, or (0, 4, 4)
+    when the box does not face up or is narrow enough for the box-face grasps.
+
+    The gripper comes down along the box's −z (the object's axis), its fingers closing radially
+    across the wall at `cfg.rim_azimuths` angles, the grasp point `cfg.rim_wall` inside the outer
+    radius and `cfg.rim_depth` below the rim. Perception's completion makes the top rotationally
+    symmetric, so the outer radius is the box's mean cross half extent.
+    """
+    cfg = cfg or PregraspConfig()
+    X_WB = np.asarray(X_WB, float)
+    h = np.asarray(half_extents, float)
+    R = X_WB[:3, :3]
+    if R[2, 2] < 0.9 or 2.0 * min(h[0], h[1]) < cfg.rim_min_width:
+        return np.zeros((0, 4, 4))
+    radius = 0.5 * (h[0] + h[1]) - cfg.rim_wall
+    y_G = -R[:, 2]
+    out = []
+    for angle in np.arange(cfg.rim_azimuths) * (2.0 * np.pi / cfg.rim_azimuths):
+        u = np.cos(angle) * R[:, 0] + np.sin(angle) * R[:, 1]  # radial: the closing axis
+        p_grasp = X_WB[:3, 3] + radius * u + (h[2] - min(cfg.rim_depth, h[2])) * R[:, 2]
+        X = np.eye(4)
+        X[:3, 0], X[:3, 1], X[:3, 2] = u, y_G, np.cross(u, y_G)
+        X[:3, 3] = p_grasp - X[:3, :3] @ WSG_GRASP_POINT_G
+        out.append(X)
+    return np.array(out)
+
+
 def part_pregrasps(boxes: dict[str, tuple[np.ndarray, np.ndarray]], part_index,
                    cfg: PregraspConfig | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Pre-grasps of every part box: ((M, 4, 4) X_WG, (M,) part labels).
 
-    `boxes` maps a part name to (X_WB, half extents); `part_index` maps a name to its label.
+    `boxes` maps a part name to (X_WB, half extents); `part_index` maps a name to its label. The
+    twelve box-face pre-grasps per part come first, then the rim grasps of a wide upright top.
     """
     if not boxes:
         return np.zeros((0, 4, 4)), np.zeros(0, int)
     X = box_pregrasps(np.stack([b[0] for b in boxes.values()]),
                       np.stack([b[1] for b in boxes.values()]), cfg)
-    return X, np.repeat([part_index(name) for name in boxes], 12)
+    labels = np.repeat([part_index(name) for name in boxes], 12)
+    if "top" in boxes:
+        rim = rim_pregrasps(*boxes["top"], cfg)
+        X = np.concatenate([X, rim])
+        labels = np.concatenate([labels, np.full(len(rim), part_index("top"))])
+    return X, labels

@@ -247,6 +247,10 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         for X_WG in variants:
             width = _part_width(target, part, X_WG)
             if width > config.open_width - config.width_margin:
+                # The box overstates what lies between the fingers for a grasp across a wall
+                # (a rim grasp on a bowl): measure the perceived points there instead.
+                width = min(width, _width_between_pads(target, X_WG))
+            if width > config.open_width - config.width_margin:
                 costs[i], reasons[i] = np.inf, (f"{part} is {width:.3f} m across the fingers; "
                                                 f"the WSG opens {config.open_width} m")
                 continue
@@ -442,6 +446,19 @@ def _part_width(target: ObjectDescription, part: str, X_WG: np.ndarray) -> float
         return 0.0
     x_B = np.asarray(box.X_WB)[:3, :3].T @ X_WG[:3, 0]
     return float(2.0 * np.abs(x_B) @ np.asarray(box.half_extents))
+
+
+def _width_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
+    """Twice the largest |x_G| of the target's perceived points in the slab the open finger pads
+    sweep (along the approach over the pads' length, across their width, out to their outer
+    faces): the opening the grasp needs. inf when no point lies there (nothing to grasp)."""
+    p_G = (np.asarray(target.p_W, float) - X_WG[:3, 3]) @ X_WG[:3, :3]
+    lo, hi = PAD_CORNERS_G[:, 1].min(), PAD_CORNERS_G[:, 1].max()
+    half_width = PAD_CORNERS_G[:, 2].max()
+    outer = PAD_CORNERS_G[:, 0].max()
+    inside = ((p_G[:, 1] >= lo) & (p_G[:, 1] <= hi) & (np.abs(p_G[:, 2]) <= half_width)
+              & (np.abs(p_G[:, 0]) <= outer))
+    return float(2.0 * np.abs(p_G[inside, 0]).max()) if inside.any() else float("inf")
 
 
 @dataclass
