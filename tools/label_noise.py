@@ -35,7 +35,13 @@ import numpy as np
 from tg_drake.errors import GraspingError
 from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
 from tg_drake.grasping.episode import EpisodeConfig, run_grasp_batch
-from tg_drake.grasping.repeatability import analyse, nudge, stratified_sample, stratum_weights
+from tg_drake.grasping.repeatability import (
+    analyse,
+    held,
+    nudge,
+    stratified_sample,
+    stratum_weights,
+)
 from tg_drake.objects import get_object
 
 
@@ -146,7 +152,10 @@ def main(argv=None) -> int:
              executor=make_executor(args.executor, workers=args.workers, address=args.address))
     keys = {j.key for j in jobs}
     rows = [json.loads(line) for line in args.out.read_text().splitlines() if line.strip()]
-    result = analyse([r for r in rows if r["job"] in keys], groups=groups,
+    source = {(r["job"], r["index"]): r for r in sample}
+    rows = [dict(r, original_held=held(source[(r["source_job"], r["source_index"])]))
+            if "source_job" in r else r for r in rows if r["job"] in keys]
+    result = analyse(rows, groups=groups,
                      weights=stratum_weights(records, sample, stratum),
                      reference="exact" if args.episode else "recorded")
     result.update(episode=args.episode or "as collected", per_stratum=args.per_stratum, nudges=args.nudges, nudge_mm=args.nudge_mm,

@@ -269,10 +269,9 @@ def main(argv=None) -> int:
     results["model_bytes"] = args.model_out.stat().st_size
     args.results.mkdir(parents=True, exist_ok=True)
     previous = args.results / "dgi.json"
-    if previous.is_file():  # tools/label_noise.py's study, kept across retraining.
-        kept = json.loads(previous.read_text()).get("label_repeatability")
-        if kept:
-            results["label_repeatability"] = kept
+    if previous.is_file():  # tools/label_noise.py's studies, kept across retraining.
+        results.update({k: v for k, v in json.loads(previous.read_text()).items()
+                        if k.startswith("label_repeatability")})
     variants = args.results / "dgi_variants.json"  # tools/dgi_variants.py, if it was run.
     if variants.is_file():
         results["variants"] = json.loads(variants.read_text())
@@ -350,6 +349,7 @@ def markdown(r: dict) -> str:
     lines += variants_markdown(r.get("variants"))
     lines += nonlocal_markdown(r)
     lines += repeatability_markdown(r.get("label_repeatability"))
+    lines += gentle_markdown(r.get("label_repeatability"), r.get("label_repeatability_gentle"))
     lines += [
         "",
         "Regenerate (data, model and these tables, then the repeatability study and this page):",
@@ -468,6 +468,37 @@ def nonlocal_markdown(r: dict) -> list[str]:
         "The shipped model stays a model of local shape (the paper's P(grasp | local shape); the",
         "logic's P(part | task) carries what is known about the object). In the folds by object,",
         f"γ and C were chosen on each fold's training objects alone ({nested}).",
+    ]
+
+
+def gentle_markdown(rep: dict | None, gentle: dict | None) -> list[str]:
+    """tools/label_noise.py with a gentler episode script (--episode, --key gentle)."""
+    if not (rep and gentle):
+        return []
+    return [
+        "",
+        "### Is the episode script the problem?",
+        "",
+        f"A smaller sample ({gentle['n_grasps']} grasps) ran with a gentler script "
+        f"(`{gentle['episode']}`: the shake's accelerations about a quarter to an eighth of the "
+        "collection's, a slower lift), nudged in the same way; the nudged labels are compared "
+        "with that script's own label for the same pose.",
+        "",
+        "| script | nudged label repeats | ceiling |",
+        "|---|---|---|",
+        f"| as collected | {100 * rep['nudged_agreement']:.1f} % | "
+        f"{100 * rep['accuracy_ceiling_interval'][0]:.0f}–"
+        f"{100 * rep['accuracy_ceiling_interval'][1]:.0f} % |",
+        f"| gentler | {100 * gentle['nudged_agreement']:.1f} % | "
+        f"{100 * gentle['accuracy_ceiling_interval'][0]:.0f}–"
+        f"{100 * gentle['accuracy_ceiling_interval'][1]:.0f} % |",
+        "",
+        f"The gentler script keeps the collected label of {100 * gentle['exact_repeat_rate']:.1f} %"
+        " of these grasps.",
+        "",
+        "```",
+        gentle["command"],
+        "```",
     ]
 
 

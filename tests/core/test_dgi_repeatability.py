@@ -111,5 +111,11 @@ def test_analyse_counts_repeats_flips_and_weights():
     exact = analyse(changed, groups=lambda r: [], reference="exact")
     assert exact["nudged_agreement"] == pytest.approx((2 + 1 + 0) / 5)
     assert exact["exact_repeat_rate"] == pytest.approx(2 / 3)
+    # Grasp 3 held the first time too, and its nudge held: a flip of the finger-gap rule only.
+    both = [dict(r, original_held=r["source_index"] == 3, touches_left_pad=True,
+                 touches_right_pad=True) for r in rows]
+    assert analyse(both, groups=lambda r: [])["flips"] == {
+        "held both times, the finger-gap rule flipped": 1,
+        "success became failure: closed on it, still on the table": 1}
     with pytest.raises(GraspingError, match="allowed: recorded, exact"):
         analyse(rows, groups=lambda r: [], reference="first")

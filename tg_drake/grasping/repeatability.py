@@ -79,6 +79,12 @@ def nudge(X_WG: np.ndarray, rng: np.random.Generator, *, distance: float, angle:
     return X
 
 
+def held(result: dict) -> bool:
+    """The object ended between both pads and off the table (whatever the finger gap)."""
+    return bool(result.get("touches_left_pad") and result.get("touches_right_pad")
+                and not result.get("touches_table"))
+
+
 def accuracy_ceiling(agreement: float) -> tuple[float, float]:
     """(lower, upper) bound of the attainable accuracy from the mean label agreement ā."""
     if not 0.0 <= agreement <= 1.0:
@@ -97,7 +103,9 @@ def analyse(rows: list[dict], *, groups: Callable[[dict], list[str]],
     category, label), reported apart as plain means over the sample; with `weights` (per source
     grasp, `stratum_weights`) the headline agreement and the ceiling are weighted to the data set.
     Flips are sorted by what the re-execution saw (`held_gap`: fingers further apart than this
-    closed on something). `reference`: the label the nudged ones are compared with, "recorded"
+    closed on something); a row's optional "original_held" (`held` of the recorded episode) singles
+    out the flips where both episodes held the object and only the label's finger-gap thresholds
+    differed. `reference`: the label the nudged ones are compared with, "recorded"
     (the data set's) or "exact" (the re-execution with the same pose: for a changed episode
     script, whose labels the data set does not have); grasps without it are left out.
     """
@@ -131,7 +139,9 @@ def analyse(rows: list[dict], *, groups: Callable[[dict], list[str]],
         for name, t in trials.items():
             if t["success"] == original:
                 continue
-            if not original:
+            if first.get("original_held") and held(t):
+                flips["held both times, the finger-gap rule flipped"] += 1
+            elif not original:
                 flips["failure became success"] += 1
             elif t["touches_table"] and t["finger_gap"] > held_gap:
                 flips["success became failure: closed on it, still on the table"] += 1
