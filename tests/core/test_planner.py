@@ -306,3 +306,70 @@ def test_a_rim_grasp_needs_only_the_wall_between_the_fingers():
     assert _width_between_pads(bowl, across) > PlannerConfig().open_width
     away = grasp_pose([0.5, -0.2, 0.055], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
     assert _width_between_pads(bowl, away) == np.inf
+
+
+def test_a_steep_grasp_far_out_is_also_tried_leaning_back_towards_the_robot():
+    from tg_drake.planning.planner import approach_variants
+
+    config = PlannerConfig()
+    X = grasp_pose([0.85, 0.0, 0.05], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
+    variants = approach_variants(X, config)
+    assert len(variants) == 1 + len(config.top_tilts)
+    p_grasp = X[:3, 3] + GRASP_POINT * X[:3, 1]
+    for V, tilt in zip(variants[1:], config.top_tilts):
+        # Same grasp point and closing axis; the wrist (−y_G) leans back towards the robot at
+        # the origin by the tilt.
+        np.testing.assert_allclose(V[:3, 3] + GRASP_POINT * V[:3, 1], p_grasp, atol=1e-12)
+        np.testing.assert_allclose(V[:3, 0], X[:3, 0], atol=1e-12)
+        assert -V[0, 1] < 0.0
+        assert np.degrees(np.arccos(-V[2, 1])) == pytest.approx(tilt)
+    # Closing towards the robot, the wrist cannot lean back about the closing axis.
+    radial = grasp_pose([0.85, 0.0, 0.05], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
+    assert len(approach_variants(radial, config)) == 1
+
+
+def test_fingers_do_not_close_along_a_long_part():
+    from tg_drake.planning.planner import _closes_along_length
+
+    knife = box_object([0.75, 0.0, 0.01], [0.02, 0.09, 0.02], parts=("handle",))
+    along = grasp_pose([0.75, 0.0, 0.01], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
+    across = grasp_pose([0.75, 0.0, 0.01], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
+    assert "along the 0.090 m length of handle" in _closes_along_length(
+        knife, "handle", along, PlannerConfig())
+    assert _closes_along_length(knife, "handle", across, PlannerConfig()) == ""
+    cube = box_object([0.75, 0.0, 0.03], [0.06, 0.06, 0.06], parts=("middle",))
+    assert _closes_along_length(cube, "middle", along, PlannerConfig()) == ""
+
+
+def test_a_part_too_flat_for_the_pads_above_the_table_is_refused():
+    from tg_drake.planning.planner import TABLE_CLEARANCE, _depth_between_pads, clear_of_table
+
+    def plate(thickness):
+        g = np.linspace(-0.03, 0.03, 31)
+        x, y, z = np.meshgrid(g, g, np.linspace(0.0, thickness, 4))
+        o = box_object([0.75, 0.0, thickness / 2], [0.06, 0.06, thickness], parts=("middle",))
+        o.p_W = np.column_stack([0.75 + x.ravel(), y.ravel(), z.ravel()])
+        return o
+
+    X = clear_of_table(grasp_pose([0.75, 0.0, 0.0], approach_W=[0, 0, -1],
+                                  closing_W=[0, 1, 0]), 0.0)
+    # The pads' tips stay TABLE_CLEARANCE above the table: a plate reaches (thickness −
+    # clearance) between them.
+    for thickness in (0.012, 0.03):
+        assert _depth_between_pads(plate(thickness), X) == pytest.approx(
+            thickness - TABLE_CLEARANCE, abs=1e-9)
+    assert _depth_between_pads(plate(0.012), X) < PlannerConfig().min_pad_depth
+
+
+def test_place_variants_turn_the_object_about_the_vertical_through_its_centre():
+    from tg_drake.planning.planner import _place_variants
+
+    X = RigidTransform(RotationMatrix.MakeXRotation(np.pi / 2), [0.75, -0.3, 0.04]).GetAsMatrix4()
+    variants = _place_variants(X, PlannerConfig())
+    assert len(variants) == len(PlannerConfig().place_yaws)
+    np.testing.assert_allclose(variants[0], X, atol=1e-12)  # the kept orientation first
+    for V, yaw in zip(variants, PlannerConfig().place_yaws):
+        np.testing.assert_allclose(V[:3, 3], X[:3, 3])
+        np.testing.assert_allclose(V[2, :3], X[2, :3], atol=1e-12)  # heights of the axes kept
+        turn = V[:3, :3] @ X[:3, :3].T
+        assert np.degrees(np.arctan2(turn[1, 0], turn[0, 0])) == pytest.approx(yaw, abs=1e-9)

@@ -17,8 +17,9 @@ solutions, inside the joint limits and clear of collisions, for
     place       X_WG carried with the object to X_WO_place          (in the hand)
     retreat     the place pose moved `retreat_distance` along −y_G  (the target at the place)
 
-where X_WO_place is the object's pose X_WO moved to the place target's xy, its orientation kept,
-and raised so that its box's lowest corner is `release_height` above the table. The IK is local,
+where X_WO_place is the object's pose X_WO moved to the place target's xy, its orientation kept
+(or turned about the vertical by one of `place_yaws` when the kept one cannot be placed), and
+raised so that its box's lowest corner is `release_height` above the table. The IK is local,
 so every pose is tried from several seeds (the start posture, IIWA_HOME and postures turned
 towards the target). The joint trajectories between these configurations come from
 `tg_drake.planning.trajectory.plan_segment` (kinematic trajectory optimisation, collision checked
@@ -86,12 +87,22 @@ class PlannerConfig:
         (0.0, 0.3, 0.0, -1.6, 0.0, -1.0, 0.0),  # wrist flipped
         (0.0, 0.2, 0.0, -1.0, 0.0, 1.6, 0.0),  # from above
     )  # [rad] IK seeds; each is also tried with joint 1 turned towards the target.
+    min_pad_depth: float = 0.01  # [m] how far along the pads (the approach) the object must
+    # reach between them: a knife's 12 mm blade lying flat rises only 7 mm above the pads'
+    # lowest point (TABLE_CLEARANCE) and was pressed out of the fingers.
+    max_length_ratio: float = 2.0  # fingers do not close along a part's length when it is this
+    # many times longer than its other extents (a knife's handle, taken end to end, slipped out).
+    place_yaws: tuple = (0.0, 60.0, -60.0, 120.0, -120.0, 180.0)  # [deg] turns of the object
+    # about the vertical tried at the place, in order (the first one that can be planned).
     max_candidates_per_part: int = 12  # candidates examined per part before giving up on it.
     # A side grasp (approach within 30° of horizontal) is also tried tilted downwards about the
     # closing axis through its grasp point by these angles [deg]: the fingers still close across
     # the same part, and the wrist rises clear of the table (horizontal grasps low on an object
     # are out of the iiwa's reach at the table's distance).
     approach_tilts: tuple = (10.0, 20.0, 35.0)
+    # A steep (top-down) grasp is also tried with its wrist tilted back towards the robot about
+    # the closing axis by these angles [deg] (only when the closing axis lets it lean that way).
+    top_tilts: tuple = (15.0, 30.0)
     free_limits: SegmentLimits = field(default_factory=SegmentLimits)  # moving to the pre-grasp
     contact_limits: SegmentLimits = field(default_factory=lambda: SegmentLimits(
         velocity_scale=0.25, min_duration=1.0))  # straight moves at the object
@@ -251,31 +262,55 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 # (a rim grasp on a bowl): measure the perceived points there instead.
                 width = min(width, _width_between_pads(target, X_WG))
             if width > config.open_width - config.width_margin:
-                costs[i], reasons[i] = np.inf, (f"{part} is {width:.3f} m across the fingers; "
-                                                f"the WSG opens {config.open_width} m")
+                costs[i] = np.inf
+                reasons[i] = _farthest(reasons[i], f"{part} is {width:.3f} m across the fingers; "
+                                                   f"the WSG opens {config.open_width} m")
                 continue
-            key = _key_poses(arms, X_WG, X_WO, X_WO_place, config)
-            below = [n for n in ("pre-grasp", "grasp") if key.X[n].translation()[2] < table_z]
-            if below:  # the WSG body's origin under the table top: no need to ask the IK
-                costs[i], reasons[i] = np.inf, f"{below[0]} pose puts the gripper under the table"
+            along = _closes_along_length(target, part, X_WG, config)
+            if along:
+                costs[i], reasons[i] = np.inf, _farthest(reasons[i], along)
                 continue
-            poses, failure = _waypoint_configurations(arms, key, seeds, config)
-            if "pre-grasp" in poses:
-                part_reachable[part] = True
-            if failure:
-                # Failing on a place pose, the pick poses were reachable (motions untried).
-                part_pickable[part] |= PICK_POSES <= set(poses)
-                costs[i], reasons[i] = np.inf, failure
+            depth = _depth_between_pads(target, X_WG)
+            if depth < config.min_pad_depth:
+                costs[i] = np.inf
+                reasons[i] = _farthest(reasons[i], (
+                    f"only {depth * 1000:.0f} mm of the object reaches between the pads (at least "
+                    f"{config.min_pad_depth * 1000:.0f} mm): too flat to pick up from the table"))
                 continue
-            plan, failure, picked = _trajectories(arms, q_start, poses, key, config, seeds,
-                                                  candidate=int(i), part=part)
-            part_pickable[part] |= picked
-            if plan is None:
-                costs[i], reasons[i] = np.inf, failure
-                continue
-            costs[i] = -np.log(score[i])
-            found = True
-            break
+            for X_WO_place_yawed in _place_variants(X_WO_place, config):
+                key = _key_poses(arms, X_WG, X_WO, X_WO_place_yawed, config)
+                below = [n for n in ("pre-grasp", "grasp")
+                         if key.X[n].translation()[2] < table_z]
+                if below:  # the WSG body's origin under the table top: no need to ask the IK
+                    costs[i] = np.inf
+                    reasons[i] = _farthest(reasons[i],
+                                           f"{below[0]} pose puts the gripper under the table")
+                    break
+                poses, failure = _waypoint_configurations(arms, key, seeds, config)
+                if "pre-grasp" in poses:
+                    part_reachable[part] = True
+                if failure:
+                    # Failing on a place pose, the pick poses were reachable (motions untried):
+                    # the object turned another way at the place may do.
+                    picked = PICK_POSES <= set(poses)
+                    part_pickable[part] |= picked
+                    costs[i], reasons[i] = np.inf, _farthest(reasons[i], failure)
+                    if picked:
+                        continue
+                    break
+                plan, failure, picked = _trajectories(arms, q_start, poses, key, config, seeds,
+                                                      candidate=int(i), part=part)
+                part_pickable[part] |= picked
+                if plan is None:
+                    costs[i], reasons[i] = np.inf, _farthest(reasons[i], failure)
+                    if picked:
+                        continue
+                    break
+                costs[i] = -np.log(score[i])
+                found = True
+                break
+            if found:
+                break
         if found:
             break
 
@@ -297,11 +332,32 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                       elapsed, plan.candidate, plan.part)
 
 
+def _farthest(old: str, new: str) -> str:
+    """Of two reasons a candidate's variants failed, the one that got farthest: a place failure
+    (the pick was found) over a pick failure, else the first."""
+    if not old or (new.startswith(PLACE_FAILURES) and not old.startswith(PLACE_FAILURES)):
+        return new
+    return old
+
+
+def _place_variants(X_WO_place: np.ndarray, config: PlannerConfig) -> list[np.ndarray]:
+    """The place pose turned about the vertical through the object's centre by each of
+    `config.place_yaws`: the task says where the object goes, not which way it faces."""
+    out = []
+    for yaw in np.deg2rad(config.place_yaws):
+        c, s_ = np.cos(yaw), np.sin(yaw)
+        X = X_WO_place.copy()
+        X[:3, :3] = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]]) @ X_WO_place[:3, :3]
+        out.append(X)
+    return out
+
+
 # The open finger pads in G (tools/make_robot_models.py: pads 0.012 × 0.082 × 0.02 m centred
 # 0.055 m along +y_G, inner faces at x = ±0.055 when open): the 8 corners of the pair [m].
 PAD_CORNERS_G = np.array([[sx * x, y, sz * 0.01] for sx in (-1, 1) for x in (0.067,)
                           for y in (0.014, 0.096) for sz in (-1, 1)])
 TABLE_CLEARANCE = 0.004  # [m] the open pads' lowest corner above the table top
+GRASP_OPENING = 0.11  # [m] between the open pads' inner faces
 
 
 def clear_of_table(X_WG: np.ndarray, table_z: float) -> np.ndarray | None:
@@ -355,14 +411,31 @@ def target_shapes(target: ObjectDescription) -> list[tuple]:
 def approach_variants(X_WG: np.ndarray, config: PlannerConfig, *, table_z: float = 0.0
                       ) -> list[np.ndarray]:
     """X_WG itself, then, for a side grasp, X_WG tilted downwards about its closing axis x_G
-    through the grasp point (GRASP_DEPTH along +y_G) by each of `config.approach_tilts`; each
-    moved back along its approach when its open pads would reach under the table
-    (`clear_of_table`), and dropped when that cannot help."""
+    through the grasp point (GRASP_DEPTH along +y_G) by each of `config.approach_tilts`, and for
+    a steep grasp, tilted back towards the robot by each of `config.top_tilts`; each moved back
+    along its approach when its open pads would reach under the table (`clear_of_table`), and
+    dropped when that cannot help."""
     variants = [X_WG]
     y = X_WG[:3, 1]
-    if abs(y[2]) > np.sin(np.deg2rad(30.0)):
-        return [X for X in map(lambda V: clear_of_table(V, table_z), variants) if X is not None]
     p_grasp = X_WG[:3, 3] + GRASP_DEPTH * y
+    if abs(y[2]) > np.sin(np.deg2rad(30.0)):
+        # A steep grasp far out on the table (a knife at 0.82 m) can be out of reach with the
+        # wrist straight above it: tilt the wrist back towards the robot about the closing axis.
+        towards_robot = -p_grasp[:2] / max(np.linalg.norm(p_grasp[:2]), 1e-9)
+        for tilt in np.deg2rad(config.top_tilts):
+            best = None
+            for sign in (1.0, -1.0):
+                c, s_ = np.cos(sign * tilt), np.sin(sign * tilt)
+                R = X_WG[:3, :3] @ np.array([[1, 0, 0], [0, c, -s_], [0, s_, c]])
+                lean = -R[:2, 1] @ towards_robot  # the body (−y_G) leans towards the robot
+                if best is None or lean > best[0]:
+                    best = (lean, R)
+            if best[0] > 1e-6:
+                X = np.eye(4)
+                X[:3, :3] = best[1]
+                X[:3, 3] = p_grasp - GRASP_DEPTH * best[1][:, 1]
+                variants.append(X)
+        return [X for X in map(lambda V: clear_of_table(V, table_z), variants) if X is not None]
     for tilt in np.deg2rad(config.approach_tilts):
         for sign in (1.0, -1.0):
             c, s_ = np.cos(sign * tilt), np.sin(sign * tilt)
@@ -416,9 +489,11 @@ class _Arms:
     def grasp(self) -> ArmPlant:
         return self._make("grasp", self._target, finger_contact=[t[0] for t in self._target])
 
-    @property
-    def placed(self) -> ArmPlant:
-        return self._make("placed", [self._placed], finger_contact=[self._placed[0]])
+    def placed(self, X_WO_place: np.ndarray) -> ArmPlant:
+        name, _, size = self._placed
+        key = ("placed", tuple(np.round(np.asarray(X_WO_place).ravel(), 9)))
+        box = (name, RigidTransform(np.asarray(X_WO_place)), size)
+        return self._make(key, [box], finger_contact=[name])
 
     def carry(self, X_GO: RigidTransform) -> ArmPlant:
         key = ("carry", tuple(np.round(X_GO.GetAsMatrix4().ravel(), 9)))
@@ -461,6 +536,42 @@ def _width_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
     return float(2.0 * np.abs(p_G[inside, 0]).max()) if inside.any() else float("inf")
 
 
+def _slab_points(target: ObjectDescription, X_WG: np.ndarray) -> np.ndarray:
+    """The target's perceived points in G that lie between the open finger pads: along the
+    approach over the pads' length, across their width, inside their inner faces."""
+    p_G = (np.asarray(target.p_W, float) - X_WG[:3, 3]) @ X_WG[:3, :3]
+    lo, hi = PAD_CORNERS_G[:, 1].min(), PAD_CORNERS_G[:, 1].max()
+    inside = ((p_G[:, 1] >= lo) & (p_G[:, 1] <= hi)
+              & (np.abs(p_G[:, 2]) <= PAD_CORNERS_G[:, 2].max())
+              & (np.abs(p_G[:, 0]) <= GRASP_OPENING / 2))
+    return p_G[inside]
+
+
+def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
+    """How far along the approach the object reaches between the pads [m]: from the pads' tips
+    back to its nearest point there (inf when perception gave no points: nothing to check)."""
+    if len(target.p_W) == 0:
+        return float("inf")
+    p = _slab_points(target, X_WG)
+    return float(PAD_CORNERS_G[:, 1].max() - p[:, 1].min()) if len(p) else 0.0
+
+
+def _closes_along_length(target: ObjectDescription, part: str, X_WG: np.ndarray,
+                         config: PlannerConfig) -> str:
+    """Why the fingers would close along the length of an elongated part ("" if they do not)."""
+    box = target.part_boxes.get(part)
+    if box is None:
+        return ""
+    size = 2.0 * np.asarray(box.half_extents, float)
+    k = int(np.argmax(size))
+    others = np.delete(size, k)
+    axis = np.asarray(box.X_WB, float)[:3, k]
+    if size[k] >= config.max_length_ratio * others.max() and abs(axis @ X_WG[:3, 0]) > 0.7:
+        return (f"the fingers would close along the {size[k]:.3f} m length of {part}, not "
+                "across it")
+    return ""
+
+
 @dataclass
 class _KeyPoses:
     """The gripper poses of one candidate and the plant that carries its object."""
@@ -501,7 +612,7 @@ def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
         "lift": (lambda: arms.carry(key.X_GO), config.min_distance),
         "pre-place": (lambda: arms.carry(key.X_GO), config.min_distance),
         "place": (lambda: arms.carry(key.X_GO), config.contact_min_distance),
-        "retreat": (lambda: arms.placed, config.contact_min_distance),
+        "retreat": (lambda: arms.placed(key.X_WO_place), config.contact_min_distance),
     }
     poses: dict[str, np.ndarray] = {}
     previous = None
@@ -538,7 +649,8 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
         ("carry", "lift", "pre-place", carry, c.min_distance, c.carry_limits, None),
         ("descend", "pre-place", "place", carry, c.contact_min_distance, c.contact_limits,
          _line(key, "pre-place", "place")),
-        ("retreat", "place", "retreat", arms.placed, c.contact_min_distance, c.contact_limits,
+        ("retreat", "place", "retreat", arms.placed(key.X_WO_place), c.contact_min_distance,
+         c.contact_limits,
          _line(key, "place", "retreat")),
     ]
     q = dict(poses, start=np.asarray(q_start, float))
