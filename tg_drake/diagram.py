@@ -29,6 +29,7 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantValueSource
 
 from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.objects import box_centre
 from tg_drake.scenario import PipelineConfig, Scenario
 from tg_drake.station import Station, add_station, placement_pose
 from tg_drake.targeting import select_target
@@ -112,7 +113,9 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
             X_WT=scenario.X_WT.GetDeterministicValue(),
             poses=[p.pose for p in scenario.objects],
             containments=[p.containment for p in scenario.objects]))
-    target = builder.AddNamedSystem("target", TargetSelector(X_WO_target.translation()))
+    # The user points at the target's middle (its box centre; its frame's origin is at its base).
+    target = builder.AddNamedSystem("target", TargetSelector(
+        X_WO_target.multiply(box_centre(target_placement.id))))
     builder.Connect(perception.GetOutputPort("scene_description"), target.get_input_port())
     scene = target.get_output_port()
 

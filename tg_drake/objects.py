@@ -233,6 +233,13 @@ def mesh(obj: LibraryObject | str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return _mesh(_as_object(obj).id)
 
 
+def box_centre(obj: LibraryObject | str) -> np.ndarray:
+    """(3,) the centre of the object's bounding box in its frame O [m]. O's origin sits at the
+    object's base, so a lying object's centre is half a length from it."""
+    V = mesh(obj)[0]
+    return 0.5 * (V.min(axis=0) + V.max(axis=0))
+
+
 def sample_surface(obj: LibraryObject | str, *, n: int | None = None,
                    spacing: float | None = None, rng: np.random.Generator):
     """Points uniformly distributed on the object's surface (the paper's S_SYN point clouds).

@@ -153,15 +153,9 @@ def run_scenario(scenario, *, scenario_path: str = "", meshcat=None, images_dir:
     return result
 
 
-def _box_centre(object_id: str) -> np.ndarray:
-    """The centre of a library object's bounding box in its frame O [m]."""
-    from tg_drake.objects import mesh
-    V = mesh(object_id)[0]
-    return 0.5 * (V.min(axis=0) + V.max(axis=0))
-
-
 def _execute(simulator, pipeline, scenario, result, timings, visualizer) -> Outcome:
     """Simulates planning and execution; reads off what physically happened."""
+    from tg_drake.objects import box_centre
     from tg_drake.outcome import hand_contact, placed, touches_table
 
     context = simulator.get_mutable_context()
@@ -234,7 +228,7 @@ def _execute(simulator, pipeline, scenario, result, timings, visualizer) -> Outc
                                  table_instance=station.instances["table"])
         ok, detail = placed(X_WO_picked, X_WO_now, plan.X_WO_place[:2, 3],
                             released=on_table and not release.held,
-                            p_OC=_box_centre(scenario.target_placement().id))
+                            p_OC=box_centre(scenario.target_placement().id))
         if ok:
             return Outcome("placed", "", detail, **common)
         return Outcome("lifted", "slipped", detail, **common)

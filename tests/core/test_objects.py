@@ -290,3 +290,15 @@ def test_generator_reproduces_every_file_bit_for_bit():
                          capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stdout + run.stderr
     assert "every file matches" in run.stdout
+
+
+def test_box_centre_is_half_the_height_above_the_base():
+    """Library frames sit at the object's base: a bottle's centre is half its height up its axis
+    (lying on its side, half a length away on the table, which targeting and placing allow for)."""
+    from tg_drake.objects import box_centre, get_object
+
+    for obj_id in ("bottle_02", "can_01", "cup_01", "hammer_01"):
+        o = get_object(obj_id)
+        c = box_centre(o)
+        assert c[2] == pytest.approx(o.extents[2] / 2, abs=1e-4)  # extents: rounded
+    assert np.linalg.norm(box_centre("bottle_02")[:2]) < 1e-3  # round: on its axis
