@@ -79,6 +79,25 @@ def episode_config(text: str | None) -> EpisodeConfig:
     return EpisodeConfig(**overrides)
 
 
+def held_failures(records: list[dict], episode: EpisodeConfig) -> dict:
+    """Recorded failures whose object nevertheless ended between both pads and off the table:
+    the label's finger-gap rule (`EpisodeConfig.min_finger_gap`, `min_finger_travel`) called
+    them failures."""
+    from tg_drake.grasping.dgi import MAX_OPENING
+
+    ok = [r for r in records if r.get("status") == "ok"]
+    rows = [r for r in ok if not r["success"] and held(r)]
+    closed = [r for r in rows if r["finger_gap"] <= episode.min_finger_gap]
+    open_ = [r for r in rows if r["finger_gap"] >= MAX_OPENING - 2 * episode.min_finger_travel]
+    by_category: dict[str, int] = defaultdict(int)
+    for r in rows:
+        by_category[category(r["object"])] += 1
+    return {"n": len(rows), "n_negative": sum(not r["success"] for r in ok),
+            "gap_below_min_finger_gap": len(closed),
+            "gap_above_travel_limit": len(open_),
+            "by_category": dict(sorted(by_category.items(), key=lambda kv: -kv[1]))}
+
+
 def make_jobs(sample: list[dict], *, nudges: int, distance: float, angle: float, seed: int,
               batch: int, episode: EpisodeConfig) -> list[Job]:
     """One batch of re-executions per scene: each sampled grasp exactly once, nudged `nudges`
@@ -158,8 +177,14 @@ def main(argv=None) -> int:
     result = analyse(rows, groups=groups,
                      weights=stratum_weights(records, sample, stratum),
                      reference="exact" if args.episode else "recorded")
-    result.update(episode=args.episode or "as collected", per_stratum=args.per_stratum, nudges=args.nudges, nudge_mm=args.nudge_mm,
-                  nudge_deg=args.nudge_deg, wall_seconds=time.perf_counter() - start,
+    result["held_failures"] = held_failures(records, EpisodeConfig())
+    # The same nudges labelled by contacts alone (`held`), without the finger-gap rule.
+    nudged = [r for r in rows if r.get("status") == "ok" and r["trial"] != "exact"]
+    if nudged and not args.episode:
+        result["held_rule_nudged_agreement_sample"] = float(np.mean(
+            [held(r) == r["original_held"] for r in nudged]))
+    result.update(episode=args.episode or "as collected", per_stratum=args.per_stratum,
+                  nudges=args.nudges, nudge_mm=args.nudge_mm, nudge_deg=args.nudge_deg, wall_seconds=time.perf_counter() - start,
                   command="nice -n 10 .venv/bin/python tools/label_noise.py " + " ".join(
                       sys.argv[1:] if argv is None else argv))
     print(json.dumps(result, indent=1))

@@ -529,13 +529,35 @@ def repeatability_markdown(rep: dict | None) -> list[str]:
                      f"{100 * v['nudged_agreement']:.1f} % |")
     lines += [
         "",
-        "If a grasp succeeds with probability p under such nudges, no classifier can be right on",
-        "it more often than max(p, 1 − p); two draws agree with probability a = p² + (1 − p)².",
+        "If a grasp succeeds with probability p under such nudges, no classifier that cannot tell",
+        "the nudges apart is right on it more often than max(p, 1 − p); two draws agree with",
+        "probability a = p² + (1 − p)².",
         f"From the mean agreement a = {100 * rep['nudged_agreement']:.1f} % the attainable "
         f"accuracy on these labels lies between {100 * lo:.1f} % and {100 * hi:.1f} % "
         "(a, and (1 + √(2a − 1)) / 2 by Jensen's inequality).",
         "",
         "Flips: " + ", ".join(f"{k} {v}" for k, v in rep["flips"].items()) + ".",
+    ]
+    h = rep.get("held_failures")
+    if h:
+        lines += [
+            "",
+            f"The label's finger-gap rule: {h['n']} of the {h['n_negative']} recorded failures "
+            "ended with the object between both pads and off the table — "
+            f"{h['gap_below_min_finger_gap']} with the pads closer than 2 mm (the 1–1.5 mm rims "
+            f"of the pots), {h['gap_above_travel_limit']} with fingers that moved less than 5 mm "
+            "each (bowls 100–106 mm across the rim); by category: "
+            + ", ".join(f"{c} {n}" for c, n in h["by_category"].items()) + ".",
+        ]
+        if "held_rule_nudged_agreement_sample" in rep:
+            lines += [
+                "A label by contacts alone (held = between both pads, off the table) would call "
+                "them successes, but it is no more repeatable: under the same nudges it repeats "
+                f"{100 * rep['held_rule_nudged_agreement_sample']:.1f} % against the finger-gap "
+                f"rule's {100 * rep['nudged_agreement_sample']:.1f} % (unweighted sample means), "
+                "so the label was not changed.",
+            ]
+    lines += [
         "",
         "```",
         rep["command"],

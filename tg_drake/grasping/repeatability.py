@@ -89,7 +89,7 @@ def accuracy_ceiling(agreement: float) -> tuple[float, float]:
     """(lower, upper) bound of the attainable accuracy from the mean label agreement ā."""
     if not 0.0 <= agreement <= 1.0:
         raise GraspingError(f"agreement must lie in [0, 1], got {agreement}")
-    return agreement, (1.0 + np.sqrt(max(2.0 * agreement - 1.0, 0.0))) / 2.0
+    return agreement, float((1.0 + np.sqrt(max(2.0 * agreement - 1.0, 0.0))) / 2.0)
 
 
 def analyse(rows: list[dict], *, groups: Callable[[dict], list[str]],
