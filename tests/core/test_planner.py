@@ -359,6 +359,10 @@ def test_a_part_too_flat_for_the_pads_above_the_table_is_refused():
         assert _depth_between_pads(plate(thickness), X) == pytest.approx(
             thickness - TABLE_CLEARANCE, abs=1e-9)
     assert _depth_between_pads(plate(0.012), X) < PlannerConfig().min_pad_depth
+    # Completion mirrored a 6 mm blade up to 18 mm: the points the camera saw decide.
+    blade = plate(0.018)
+    blade.visible = blade.p_W[:, 2] <= 0.006 + 1e-9
+    assert _depth_between_pads(blade, X) == pytest.approx(0.006 - TABLE_CLEARANCE, abs=1e-9)
 
 
 def test_place_variants_turn_the_object_about_the_vertical_through_its_centre():

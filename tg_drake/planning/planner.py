@@ -536,10 +536,16 @@ def _width_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
     return float(2.0 * np.abs(p_G[inside, 0]).max()) if inside.any() else float("inf")
 
 
-def _slab_points(target: ObjectDescription, X_WG: np.ndarray) -> np.ndarray:
+def _slab_points(target: ObjectDescription, X_WG: np.ndarray, *, visible_only: bool = False
+                 ) -> np.ndarray:
     """The target's perceived points in G that lie between the open finger pads: along the
-    approach over the pads' length, across their width, inside their inner faces."""
-    p_G = (np.asarray(target.p_W, float) - X_WG[:3, 3]) @ X_WG[:3, :3]
+    approach over the pads' length, across their width, inside their inner faces (only the
+    points the camera saw, not completed ones, with `visible_only`)."""
+    p_W = np.asarray(target.p_W, float)
+    visible = np.asarray(target.visible, bool)
+    if visible_only and len(visible) == len(p_W):
+        p_W = p_W[visible]
+    p_G = (p_W - X_WG[:3, 3]) @ X_WG[:3, :3]
     lo, hi = PAD_CORNERS_G[:, 1].min(), PAD_CORNERS_G[:, 1].max()
     inside = ((p_G[:, 1] >= lo) & (p_G[:, 1] <= hi)
               & (np.abs(p_G[:, 2]) <= PAD_CORNERS_G[:, 2].max())
@@ -549,10 +555,15 @@ def _slab_points(target: ObjectDescription, X_WG: np.ndarray) -> np.ndarray:
 
 def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
     """How far along the approach the object reaches between the pads [m]: from the pads' tips
-    back to its nearest point there (inf when perception gave no points: nothing to check)."""
+    back to its nearest point there (inf when perception gave no points: nothing to check).
+
+    Measured on the points the camera saw where there are any: symmetry completion mirrors a
+    flat blade about the handle's axis, which makes a 6 mm spatula blade look 16 mm tall."""
     if len(target.p_W) == 0:
         return float("inf")
-    p = _slab_points(target, X_WG)
+    p = _slab_points(target, X_WG, visible_only=True)
+    if not len(p):
+        p = _slab_points(target, X_WG)
     return float(PAD_CORNERS_G[:, 1].max() - p[:, 1].min()) if len(p) else 0.0
 
 
