@@ -185,7 +185,8 @@ def main(argv=None) -> int:
             [held(r) == r["original_held"] for r in nudged]))
     result.update(episode=args.episode or "as collected", per_stratum=args.per_stratum,
                   nudges=args.nudges, nudge_mm=args.nudge_mm, nudge_deg=args.nudge_deg,
-                  wall_seconds=time.perf_counter() - start,
+                  episode_wall_seconds=float(sum(r.get("wall_time", 0.0) for r in rows)),
+                  wall_seconds_this_run=time.perf_counter() - start,
                   command="nice -n 10 .venv/bin/python tools/label_noise.py " + " ".join(
                       sys.argv[1:] if argv is None else argv))
     print(json.dumps(result, indent=1))

@@ -520,8 +520,9 @@ def repeatability_markdown(rep: dict | None) -> list[str]:
         "| | label repeats |",
         "|---|---|",
         f"| same pose | {100 * rep['exact_repeat_rate']:.1f} % |",
-        f"| nudged pose (each of {rep['nudges'] * rep['n_grasps']} episodes) | "
-        f"{100 * rep['nudged_agreement']:.1f} % |",
+        f"| nudged pose (each of {rep['nudges'] * rep['n_grasps']} episodes), weighted to the "
+        f"data set's categories and labels | {100 * rep['nudged_agreement']:.1f} % |",
+        f"| same, plain mean over the sample | {100 * rep['nudged_agreement_sample']:.1f} % |",
         f"| all {rep['nudges']} nudges of a grasp | {100 * rep['nudged_all_agree']:.1f} % |",
     ]
     for key, v in groups.items():
@@ -544,9 +545,9 @@ def repeatability_markdown(rep: dict | None) -> list[str]:
             "",
             f"The label's finger-gap rule: {h['n']} of the {h['n_negative']} recorded failures "
             "ended with the object between both pads and off the table — "
-            f"{h['gap_below_min_finger_gap']} with the pads closer than 2 mm (the 1–1.5 mm rims "
-            f"of the pots), {h['gap_above_travel_limit']} with fingers that moved less than 5 mm "
-            "each (bowls 100–106 mm across the rim); by category: "
+            f"{h['gap_below_min_finger_gap']} with the pads closer than 2 mm (mostly the 1–1.5 mm "
+            f"rims of the pots), {h['gap_above_travel_limit']} with fingers that moved less than "
+            "5 mm each (mostly bowls 100–106 mm across); by category: "
             + ", ".join(f"{c} {n}" for c, n in h["by_category"].items()) + ".",
         ]
         if "held_rule_nudged_agreement_sample" in rep:
