@@ -5,7 +5,8 @@
     python tools/learn_theory.py --stage collect       # only run the data collection
     python tools/learn_theory.py --stage fit           # fit from collected data, write the theory
     python tools/learn_theory.py --stage compare       # held-out comparison -> docs/results/
-    options: --seed 0 --workers 1 --executor local|ray --address ADDR --max-iter 50
+    options: --seed 0 --workers 1 --executor local|ray --address ADDR --limit N --max-iter 50
+             --prior-strength 2
 
 Data. Every library object, in every pose that suits it, empty, and full when upright (containers
 only), grasped in turn at each of its parts: the pipeline runs with ground-truth perception (the
@@ -424,6 +425,9 @@ def main(argv=None) -> int:
     parser.add_argument("--executor", choices=("local", "ray"), default="local")
     parser.add_argument("--address", default=None, help="Ray cluster address")
     parser.add_argument("--data", type=Path, default=DATA, help="where the raw records go")
+    parser.add_argument("--limit", type=int, default=None,
+                        help="only the first N collection runs (the held-out objects' come "
+                        "first, then the training objects' in a seeded order)")
     parser.add_argument("--max-iter", type=int, default=50, help="EM iterations of the fit")
     parser.add_argument("--prior-strength", type=float, default=2.0,
                         help="the hand-written value counts as this many interpretations "
@@ -432,7 +436,7 @@ def main(argv=None) -> int:
     command = "python tools/learn_theory.py " + shlex.join(argv if argv is not None
                                                            else sys.argv[1:])
 
-    specs = collection_specs(args.seed)
+    specs = collection_specs(args.seed)[:args.limit]
     if args.stage in ("all", "collect"):
         records = _run(collect_one, specs, args.data / "grasps.jsonl", args)
         status = Counter(r["outcome"]["status"] for r in records)
