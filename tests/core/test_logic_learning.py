@@ -240,3 +240,44 @@ def test_only_part_keeps_indices_and_order():
     assert only.score.tolist() == [0.0, 0.8, 0.0, 0.0]  # a part the logic gave 0 is tried
     only = only_part(grasps, PART_LABELS[1])
     assert only.score.tolist() == [0.5, 0.0, 0.7, 0.0]
+
+
+# ---- the collection tool (tools/learn_theory.py) ---------------------------------------------
+
+def _tool():
+    import importlib.util
+
+    path = Path(__file__).resolve().parents[2] / "tools" / "learn_theory.py"
+    spec = importlib.util.spec_from_file_location("learn_theory", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_collection_is_seeded_and_holds_out_one_object_per_category():
+    tool = _tool()
+    specs = tool.collection_specs(0)
+    assert specs == tool.collection_specs(0)
+    assert [s["name"] for s in specs] != [s["name"] for s in tool.collection_specs(1)]
+    test = {s["id"] for s in specs if s["split"] == "test"}
+    assert sorted(i.rsplit("_", 1)[0] for i in test) == sorted(
+        {s["category"] for s in specs})
+    n_test = sum(s["split"] == "test" for s in specs)
+    assert all(s["split"] == "test" for s in specs[:n_test])  # held-out objects first
+
+
+def test_only_executed_grasps_of_the_asked_part_become_records():
+    tool = _tool()
+    base = {"scene": "cup_01_upright_empty", "category": "cup", "pose": "upright",
+            "containment": "empty", "parts": ["top", "middle", "bottom", "handle"],
+            "split": "train"}
+    raw = [{**base, "part": "middle", "grasped_part": "middle",
+            "outcome": {"status": "placed", "reason": ""}},
+           {**base, "part": "handle", "grasped_part": None,
+            "outcome": {"status": "failed", "reason": "unreachable"}},
+           {**base, "part": "top", "grasped_part": None,
+            "outcome": {"status": "failed", "reason": "perception"}},
+           {**base, "part": "bottom", "grasped_part": "middle",
+            "outcome": {"status": "placed", "reason": ""}}]
+    records = tool.grasp_records(raw)
+    assert [(r.part, r.held) for r in records] == [("middle", True), ("handle", False)]
