@@ -120,7 +120,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     scene = target.get_output_port()
 
     # Category prior, logic, grasp scoring.
-    prior = builder.AddNamedSystem("kernel_prior", KernelPriorSystem(KernelPriorConfig()))
+    prior = builder.AddNamedSystem("kernel_prior", KernelPriorSystem(KernelPriorConfig(
+        clouds="ground_truth" if config.perception == "ground_truth" else "perceived")))
     builder.Connect(scene, prior.GetInputPort("scene_description"))
     logic = builder.AddNamedSystem("logic", LogicQuerySystem(LogicQueryConfig(
         category=config.category_theory, grasp=config.grasp_theory,

@@ -338,3 +338,85 @@ def test_leave_one_object_out_drops_all_samplings_of_the_held_out_object():
     assert best(scores).T == 0 and best(scores, by="mean_rank").T == 0
     assert random_score().accuracy == pytest.approx(1 / 11)
     assert random_score().mean_rank == 6.0
+
+
+# -- perceived entries and their leave-one-object-out evaluation ------------------------------
+
+@pytest.fixture(scope="module")
+def mixed_database(clouds, projections):
+    """Each shape twice: once as a ground-truth sampling, once (another grid) as a "perceived"
+    view of the same object; only "can" has two objects."""
+    rng = np.random.default_rng(11)
+    views = [voxel_resample(c, SPACING, offset=rng.random(3) * SPACING) for c in clouds]
+    ids = ["can1", "can2", "cup1", "cup2", "hammer1", "bottle1"]
+    cats = [CATEGORIES.index(c) for c in ("can", "can", "cup", "cup", "hammer", "bottle")]
+    return KernelDatabase.build(
+        clouds + views, ids + ids, cats + cats, projections=projections, spacing=SPACING,
+        t_default=3, sources=["ground_truth"] * 6 + ["perceived"] * 6,
+        poses=[""] * 6 + ["upright"] * 6, yaws=[np.nan] * 6 + [0.0, 120.0] * 3,
+        viewpoints=[-1] * 6 + [0] * 6, entries_default="perceived")
+
+
+def test_prior_compares_with_the_chosen_entries_only(mixed_database, raw_clouds):
+    c = raw_clouds[4]
+    assert mixed_database.prior(c.points, c.normals, c.labels).neighbours[0][0] == "hammer1"
+    for entries, n in (("perceived", 6), ("ground_truth", 6), ("all", 10)):
+        d = mixed_database.prior(c.points, c.normals, c.labels, entries=entries)
+        assert len(d.neighbours) == n
+    with pytest.raises(KernelError, match="unknown database entries 'scans'"):
+        mixed_database.prior(c.points, c.normals, c.labels, entries="scans")
+
+
+def test_mixed_database_round_trip(mixed_database):
+    buf = io.BytesIO()
+    mixed_database.save(buf)
+    buf.seek(0)
+    loaded = KernelDatabase.load(buf)
+    for name in ("sources", "poses", "viewpoints"):
+        np.testing.assert_array_equal(getattr(loaded, name), getattr(mixed_database, name))
+    np.testing.assert_array_equal(loaded.yaws, mixed_database.yaws)
+    assert (loaded.entries_default, loaded.t_default) == ("perceived", 3)
+
+
+def test_member_profile_equals_the_query_of_the_same_cloud(mixed_database, clouds):
+    # Database graph 1 is clouds[1] as built (already on the database's grid).
+    c = clouds[1]
+    np.testing.assert_allclose(mixed_database.member_profile([1])[:, 0],
+                               mixed_database.similarity_profile(c.points, c.normals, c.labels),
+                               rtol=1e-12)
+
+
+def test_perceived_evaluation_never_sees_the_query_object(mixed_database):
+    from tg_drake.kernels.evaluation import evaluate_members
+
+    queries = np.flatnonzero(mixed_database.sources == "perceived")
+    result = evaluate_members(mixed_database, queries)
+    # Its own object's graphs are each perceived view's most similar graphs (K̂ = 1 with itself),
+    # and for cup, hammer and bottle the only graphs of their category (cup1 and cup2 are
+    # different mugs but one category: they may find each other). If any own graph leaked in,
+    # hammer1 and bottle1 would be right; without it they cannot be.
+    for name, (correct, rank) in result.outcomes.items():
+        ids = mixed_database.object_ids[queries]
+        assert not correct[np.isin(ids, ["hammer1", "bottle1"])].any(), name
+        assert np.all(rank[np.isin(ids, ["hammer1", "bottle1"])] > 1), name
+    # Not vacuous: the cans and cups do find their category among the other objects.
+    can_or_cup = np.isin(mixed_database.object_ids[queries], ["can1", "can2", "cup1", "cup2"])
+    assert result.outcomes["all", 3][0][can_or_cup].any()
+    assert result.score.accuracy <= 4 / 6
+
+
+def test_nested_choice_is_made_without_the_held_out_object():
+    from tg_drake.kernels.evaluation import nested_leave_one_object_out
+
+    # Two queries (objects a and b, category 0) against graphs of objects a, b, c (category 0)
+    # and d (category 1). At T = 0 both queries prefer d (wrong) over c; at T = 1 they prefer c.
+    # A held-out object's own choice may use only the other query: each sees T = 1 win.
+    ids_db, cats_db = np.array(["a", "b", "c", "d"]), np.array([0, 0, 0, 1])
+    rows = np.array([[[1.0, 0.0, 0.2, 0.9], [0.0, 1.0, 0.2, 0.9]],
+                     [[1.0, 0.0, 0.9, 0.2], [0.0, 1.0, 0.9, 0.2]]])
+    result = nested_leave_one_object_out(rows, ["a", "b"], [0, 0], ids_db, cats_db,
+                                         {"all": np.ones(4, bool)}, n_neighbours=1)
+    assert result.choices == {"a": {"T": 1, "entries": "all"}, "b": {"T": 1, "entries": "all"}}
+    assert result.score.accuracy == 1.0 and result.score.T == 1
+    # Query a's own graph (K̂ = 1) never counts: at T = 0 its only neighbour is d.
+    assert not result.outcomes["all", 0][0].any()

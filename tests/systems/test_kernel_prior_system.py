@@ -118,3 +118,29 @@ def test_default_system_uses_the_shipped_database():
     assert len(dist.neighbours) == 10  # the paper's n.
     assert dist.probabilities.sum() == pytest.approx(1.0, abs=1e-12)
     assert CATEGORIES[int(np.argmax(dist.probabilities))] == "pan"
+
+
+def test_the_database_choice_for_the_kind_of_cloud_is_used():
+    # One "ground_truth" and one "perceived" graph per object; the database chose the perceived
+    # entries at T = 2 for perceived clouds and all entries at T = 5 for ground-truth samplings.
+    rng = np.random.default_rng(4)
+    clouds = [voxel_resample(synthetic.cylinder(radius=0.033, height=0.12, n=3000, rng=rng),
+                             SPACING) for _ in range(4)]
+    db = KernelDatabase.build(
+        clouds, ["can0", "can0", "can1", "can1"], [CATEGORIES.index("can")] * 4,
+        spacing=SPACING, projections=LshProjections.sample(rng=np.random.default_rng(0)),
+        sources=["ground_truth", "perceived"] * 2, t_default=2, entries_default="perceived",
+        t_ground_truth=5, entries_ground_truth="all")
+    scene = SceneDescription(objects=[_object(clouds[0], np.zeros(3))], X_WT=np.eye(4))
+
+    def neighbours(config):
+        system = KernelPriorSystem(config, database=db)
+        context = system.CreateDefaultContext()
+        system.get_scene_description_input_port().FixValue(context, scene)
+        return system.get_category_prior_output_port().Eval(context).distributions[0].neighbours
+
+    assert len(neighbours(KernelPriorConfig())) == 2  # the two perceived graphs only
+    assert len(neighbours(KernelPriorConfig(clouds="ground_truth"))) == 4
+    assert len(neighbours(KernelPriorConfig(clouds="ground_truth", entries="perceived"))) == 2
+    with pytest.raises(KernelError, match="unknown kind of query clouds 'scans'"):
+        KernelPriorSystem(KernelPriorConfig(clouds="scans"), database=db)

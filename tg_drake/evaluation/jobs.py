@@ -94,12 +94,15 @@ def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS,
     return out
 
 
-def kernel_priors(points, normals, labels, *, object_id: str, t: int) -> dict:
-    """Label fractions (T = 0) and Manifolds (T = t) priors, leave-one-object-out."""
+def kernel_priors(points, normals, labels, *, object_id: str, t: int,
+                  clouds: str = "perceived") -> dict:
+    """Label fractions (T = 0) and Manifolds (T = t) priors, leave-one-object-out, against the
+    database entries chosen for this kind of query cloud ("perceived" or "ground_truth")."""
     from tg_drake.kernels.database import load_database
 
     db = load_database()
-    return {name: _round(db.prior(points, normals, labels, t=T,
+    entries, _ = db.choice(clouds)
+    return {name: _round(db.prior(points, normals, labels, t=T, entries=entries,
                                   exclude_object=object_id).probabilities)
             for name, T in (("label_fractions", 0), ("manifolds", t))}
 
@@ -123,7 +126,7 @@ def run_synthetic(case) -> dict:
     cloud = sample_object(obj, spacing=load_database().spacing,
                           rng=np.random.default_rng(_seed(case.key, case.seed)))
     priors = kernel_priors(cloud.points, cloud.normals, cloud.labels, object_id=obj.id,
-                           t=case.kernel_T)
+                           t=case.kernel_T, clouds="ground_truth")
     return {**case.meta(), "priors": priors,
             "methods": logic_answers(observations, priors, case.truth.tasks,
                                        theory=case.theory)}

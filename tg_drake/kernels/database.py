@@ -1,8 +1,10 @@
 """The object database of the kernel prior and the prior query against it.
 
-The database holds, per sampled graph of the object library, its hashed features φ(G_t) for
-t = 0..15 (not the raw graphs), the LSH projections that made them (queries must hash with the
-same ones), the resampling density and the T chosen by leave-one-object-out evaluation.
+The database holds, per graph of the object library, its hashed features φ(G_t) for t = 0..15
+(not the raw graphs), where it came from (a ground-truth sampling of the mesh, or a perceived
+view: pose, yaw, viewpoint), the LSH projections that made them (queries must hash with the same
+ones), the resampling density, and the T and entries chosen by leave-one-object-out
+cross-validation for perceived queries.
 `tools/build_kernel_db.py` writes it to `tg_drake/data/kernel_db.npz`; `load_default_database()`
 reads that file once per process.
 """
@@ -25,7 +27,10 @@ from tg_drake.kernels.propagation import (
     FeatureCounts, LshProjections, graph_features, propagation_hashes)
 from tg_drake.types import CATEGORIES, PART_LABELS, CategoryDistribution
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+SOURCES = ("ground_truth", "perceived")  # where a database graph came from.
+# Which database graphs a query is compared with: every graph, or those of one source.
+ENTRIES = ("all",) + SOURCES
 DEFAULT_DATABASE = "data/kernel_db.npz"  # inside the tg_drake package.
 
 
@@ -33,9 +38,28 @@ DEFAULT_DATABASE = "data/kernel_db.npz"  # inside the tg_drake package.
 class KernelPriorConfig:
     """Parameters of the kernel prior stage."""
 
-    iterations: int | None = None  # T of K_T; None: the database's T (best leave-one-out accuracy).
+    iterations: int | None = None  # T of K_T; None: the database's cross-validated T for
+    # `clouds` (leave-one-object-out).
+    entries: str | None = None  # database graphs compared with: "all", "ground_truth",
+    # "perceived"; None: the database's cross-validated choice for `clouds`.
+    clouds: str = "perceived"  # what the queries are: "perceived" clouds (perception's), or
+    # "ground_truth" samplings of the meshes; picks the database's choice of T and entries.
     n_neighbours: int = N_NEIGHBOURS  # n most similar database graphs averaged into the prior.
     database: str | None = None  # path of a kernel_db.npz; None: the one shipped in tg_drake/data.
+
+
+def prepare_cloud(points, normals, labels, *, spacing: float, k: int = K_NEIGHBOURS
+                  ) -> LabelledCloud:
+    """Validates a cloud and resamples it to `spacing` [m], as queries and perceived database
+    entries are (the grid starts at the cloud's lowest corner)."""
+    cloud = validate_cloud(points, normals, labels, k=k)
+    resampled = voxel_resample(cloud, spacing)
+    if resampled.points.shape[0] < k + 1:
+        raise KernelError(
+            f"a cloud of {resampled.points.shape[0]} point(s) after resampling at "
+            f"{spacing * 1e3:.1f} mm is too small: the k-nn graph with k = {k} "
+            f"needs at least {k + 1} points")
+    return resampled
 
 
 @dataclass
@@ -50,8 +74,35 @@ class KernelDatabase:
     k: int = K_NEIGHBOURS  # neighbours per node in the k-nn graph.
     t_default: int = 0  # T used when a query gives none.
     library_fingerprint: str = ""  # of the object library the graphs were sampled from.
+    sources: np.ndarray | None = None  # (G,) str in SOURCES; None: all "ground_truth".
+    poses: np.ndarray | None = None  # (G,) str: resting pose of a perceived view ("" otherwise).
+    yaws: np.ndarray | None = None  # (G,) [deg] yaw of a perceived view (NaN otherwise).
+    viewpoints: np.ndarray | None = None  # (G,) int: viewpoint index of a view (−1 otherwise).
+    entries_default: str = "all"  # ENTRIES a query compares with when it names none.
+    t_ground_truth: int = 0  # T and entries chosen for ground-truth samplings as queries
+    entries_ground_truth: str = "all"  # (the defaults above serve perceived clouds).
 
     def __post_init__(self):
+        g = self.object_ids.shape[0]
+        if self.sources is None:
+            self.sources = np.full(g, SOURCES[0])
+        if self.poses is None:
+            self.poses = np.full(g, "")
+        if self.yaws is None:
+            self.yaws = np.full(g, np.nan)
+        if self.viewpoints is None:
+            self.viewpoints = np.full(g, -1, dtype=np.int64)
+        self.sources, self.poses = np.asarray(self.sources, str), np.asarray(self.poses, str)
+        self.yaws = np.asarray(self.yaws, np.float64)
+        self.viewpoints = np.asarray(self.viewpoints, np.int64)
+        if not all(a.shape == (g,) for a in (self.sources, self.poses, self.yaws,
+                                             self.viewpoints)):
+            raise KernelError(f"one source, pose, yaw and viewpoint per graph ({g} graphs)")
+        unknown = sorted(set(self.sources.tolist()) - set(SOURCES))
+        if unknown:
+            raise unknown_name("database source", unknown[0], SOURCES, error=KernelError)
+        self.resolve_entries(self.entries_default)
+        self.resolve_entries(self.entries_ground_truth)
         self._self_kernels = self.features.self_kernels()
 
     @property
@@ -61,8 +112,9 @@ class KernelDatabase:
     @classmethod
     def build(cls, clouds: list[LabelledCloud], object_ids, categories, *,
               projections: LshProjections, spacing: float, k: int = K_NEIGHBOURS,
-              t_default: int = 0) -> KernelDatabase:
-        """Hashes already resampled clouds into a database (one block-diagonal diffusion)."""
+              t_default: int = 0, **entry_info) -> KernelDatabase:
+        """Hashes already resampled clouds into a database (one block-diagonal diffusion).
+        `entry_info`: sources, poses, yaws, viewpoints (one per cloud), entries_default."""
         ids = np.asarray(object_ids, dtype=str)
         cats = np.asarray(categories, dtype=np.int64)
         if not (len(clouds) == len(ids) == len(cats)):
@@ -72,9 +124,30 @@ class KernelDatabase:
             raise KernelError("an empty kernel database: give at least one cloud")
         transitions = [cloud_transition(c, k=k) for c in clouds]
         features = graph_features(transitions, [c.labels for c in clouds], projections)
-        return cls(ids, cats, features, projections, float(spacing), k, int(t_default))
+        return cls(ids, cats, features, projections, float(spacing), k, int(t_default),
+                   **entry_info)
 
     # -- queries ---------------------------------------------------------------------------
+
+    def choice(self, clouds: str) -> tuple[str, int]:
+        """(entries, T) chosen by cross-validation for queries of this kind (`SOURCES`)."""
+        if clouds not in SOURCES:
+            raise unknown_name("kind of query clouds", clouds, SOURCES, error=KernelError)
+        return ((self.entries_default, self.t_default) if clouds == "perceived"
+                else (self.entries_ground_truth, self.t_ground_truth))
+
+    def resolve_entries(self, entries: str | None) -> str:
+        entries = self.entries_default if entries is None else entries
+        if entries not in ENTRIES:
+            raise unknown_name("database entries", entries, ENTRIES, error=KernelError)
+        if entries != "all" and not np.any(self.sources == entries):
+            raise KernelError(f"the kernel database holds no {entries} graphs")
+        return entries
+
+    def entry_mask(self, entries: str | None = None) -> np.ndarray:
+        """(G,) bool: the graphs a query with these `entries` is compared with."""
+        entries = self.resolve_entries(entries)
+        return np.ones(self.sources.shape, bool) if entries == "all" else self.sources == entries
 
     def resolve_iterations(self, t: int | None) -> int:
         t = self.t_default if t is None else int(t)
@@ -84,14 +157,7 @@ class KernelDatabase:
 
     def prepare(self, points, normals, labels) -> LabelledCloud:
         """Validates a query cloud and resamples it to the database's density (`spacing`)."""
-        cloud = validate_cloud(points, normals, labels, k=self.k)
-        resampled = voxel_resample(cloud, self.spacing)
-        if resampled.points.shape[0] < self.k + 1:
-            raise KernelError(
-                f"a cloud of {resampled.points.shape[0]} point(s) after resampling at "
-                f"{self.spacing * 1e3:.1f} mm is too small: the k-nn graph with k = {self.k} "
-                f"needs at least {self.k + 1} points")
-        return resampled
+        return prepare_cloud(points, normals, labels, spacing=self.spacing, k=self.k)
 
     def similarity_profile(self, points, normals, labels, *, t: int | None = None
                            ) -> np.ndarray:
@@ -104,6 +170,16 @@ class KernelDatabase:
         row, self_k = self.features.cross(hashes)
         return row / np.sqrt(self_k[:, None] * self._self_kernels[:t + 1])
 
+    def member_profile(self, rows) -> np.ndarray:
+        """(t_max + 1, Q, G): K̂_0 .. K̂_t_max between the database graphs `rows` (indices) and
+        every database graph: what `similarity_profile` gives for the clouds they were built
+        from (leave-one-out evaluation drops the columns it must not see)."""
+        rows = np.asarray(rows, dtype=np.int64)
+        per_t = np.stack([(c[rows] @ c.T).toarray() for c in self.features.counts])
+        k = np.cumsum(per_t, axis=0)
+        s = self._self_kernels
+        return k / np.sqrt(s[:, rows][:, :, None] * s[:, None, :])
+
     def similarities(self, points, normals, labels, *, t: int | None = None) -> np.ndarray:
         """(G,) K̂_T between the query cloud and every database graph (T = t, or the
         database's T when t is None)."""
@@ -111,13 +187,16 @@ class KernelDatabase:
         return self.similarity_profile(points, normals, labels, t=t)[t]
 
     def prior(self, points, normals, labels, *, t: int | None = None,
-              n_neighbours: int = N_NEIGHBOURS, exclude_object: str | None = None
-              ) -> CategoryDistribution:
+              n_neighbours: int = N_NEIGHBOURS, exclude_object: str | None = None,
+              entries: str | None = None) -> CategoryDistribution:
         """The category prior of one cloud: the n most similar graphs weighted by exp(−rank).
 
-        `exclude_object` leaves every graph of that library object out (leave-one-object-out).
+        `entries` picks the graphs compared with ("all", "ground_truth", "perceived"; None: the
+        database's default). `exclude_object` leaves every graph of that library object out
+        (leave-one-object-out).
         """
-        sim = self.similarities(points, normals, labels, t=t)
+        mask = self.entry_mask(entries)
+        sim = np.where(mask, self.similarities(points, normals, labels, t=t), -np.inf)
         if exclude_object is not None:
             if exclude_object not in set(self.object_ids.tolist()):
                 raise unknown_name("database object", exclude_object,
@@ -144,6 +223,13 @@ class KernelDatabase:
             w=np.array(self.projections.w), spacing=np.array(self.spacing),
             k=np.array(self.k), t_default=np.array(self.t_default),
             library_fingerprint=np.array(self.library_fingerprint),
+            sources=np.argmax(self.sources[:, None] == np.array(SOURCES),
+                              axis=1).astype(np.uint8),
+            poses=self.poses, yaws=self.yaws.astype(np.float32),
+            viewpoints=self.viewpoints.astype(np.int8),
+            entries_default=np.array(self.entries_default),
+            t_ground_truth=np.array(self.t_ground_truth),
+            entries_ground_truth=np.array(self.entries_ground_truth),
             vocab_sizes=np.array([len(v) for v in f.vocabularies], dtype=np.int64),
             vocab=np.concatenate(f.vocabularies),
             # Per bin (column): how many graphs have it; then those graphs and their counts.
@@ -192,8 +278,13 @@ class KernelDatabase:
                                            w=float(data["w"])),
                 spacing=float(data["spacing"]), k=int(data["k"]),
                 t_default=int(data["t_default"]),
-                library_fingerprint=str(data["library_fingerprint"])
-                if "library_fingerprint" in data else "")
+                library_fingerprint=str(data["library_fingerprint"]),
+                sources=np.array(SOURCES)[data["sources"].astype(np.int64)],
+                poses=data["poses"].astype(str), yaws=data["yaws"].astype(np.float64),
+                viewpoints=data["viewpoints"].astype(np.int64),
+                entries_default=str(data["entries_default"]),
+                t_ground_truth=int(data["t_ground_truth"]),
+                entries_ground_truth=str(data["entries_ground_truth"]))
 
 
 @functools.lru_cache(maxsize=4)

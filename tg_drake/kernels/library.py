@@ -1,4 +1,9 @@
-"""Labelled clouds of the object library for the kernel database (the paper's S_SYN analogue).
+"""Labelled clouds of the object library for the kernel database.
+
+Two kinds of entries: ground-truth samplings of the meshes (the paper's S_SYN analogue) and
+perceived views (the S_REAL analogue: the object alone on the table, ray cast and put through
+our perception stage, with its estimated part labels), so that a perceived query meets perceived
+database graphs, as the paper compared real scans with real scans.
 
 Each sampling of an object draws points uniformly on its mesh (three times denser than the
 database spacing), turns the object by a random rotation and keeps one point per voxel of
@@ -49,6 +54,46 @@ def library_clouds(*, n_samplings: int, spacing: float = SPACING, rng: np.random
             ids.append(obj.id)
             cats.append(CATEGORIES.index(obj.category))
     return clouds, ids, cats
+
+
+# Viewpoints of the perceived entries: camera eye [m] from the object's table point, looking at
+# `VIEW_TARGET`. The first is the default scenario camera's (`tg_drake.evaluation.jobs.P_CAMERA`);
+# the others are lower and closer, and higher and farther.
+VIEWPOINTS = ((0.8, 0.0, 0.55), (0.65, 0.0, 0.40), (0.9, 0.0, 0.80))
+VIEW_TARGET = (0.0, 0.0, 0.05)
+VIEW_YAWS_DEG = (0.0, 60.0, 120.0, 180.0, 240.0, 300.0)  # object turns about the table normal.
+
+
+def perceived_views(*, object_ids=None, viewpoints=VIEWPOINTS, yaws_deg=VIEW_YAWS_DEG,
+                    progress=None) -> tuple[list[dict], list[dict]]:
+    """Perceived clouds of library objects, one per resting pose × viewpoint × yaw
+    (`tg_drake.evaluation.jobs.perceive`: the depth image ray cast, then `describe_scene`).
+
+    Returns (views, failures) in library order. A view is a dict with object, category, pose,
+    yaw, view (index into `viewpoints`) and description (the perceived `ObjectDescription`);
+    a failure has a reason instead (perception found no object). `progress(done, total)` is
+    called after each view.
+    """
+    from tg_drake.errors import PerceptionError
+    from tg_drake.evaluation.jobs import perceive
+    from tg_drake.objects import get_object, load_library
+
+    objects = list(load_library().values()) if object_ids is None else \
+        [get_object(i) for i in object_ids]
+    jobs = [(obj, pose, v, yaw) for obj in objects for pose in obj.poses
+            for v in range(len(viewpoints)) for yaw in yaws_deg]
+    views, failures = [], []
+    for done, (obj, pose, v, yaw) in enumerate(jobs, start=1):
+        entry = {"object": obj.id, "category": obj.category, "pose": pose, "yaw": float(yaw),
+                 "view": v}
+        try:
+            views.append({**entry, "description": perceive(
+                obj.id, pose, yaw, p_camera=viewpoints[v], p_target=VIEW_TARGET)})
+        except PerceptionError as e:
+            failures.append({**entry, "reason": str(e)})
+        if progress is not None:
+            progress(done, len(jobs))
+    return views, failures
 
 
 def library_fingerprint() -> str:

@@ -23,7 +23,10 @@ class KernelPriorSystem(LeafSystem):
 
     For each object of ``scene_description`` (a `SceneDescription`), its completed cloud, normals
     and part labels make a weighted k-nn graph; its propagation kernel against the object
-    database ranks the database graphs, and the n most similar, weighted by exp(−rank), give a
+    database ranks the database graphs (by default the entries and T the database chose by
+    cross-validation for `config.clouds`: for perceived clouds, perceived views of the library,
+    so that a perceived object meets perceived objects), and the n most similar, weighted by
+    exp(−rank), give a
     `CategoryDistribution` (with the neighbours listed). ``category_prior`` is a `CategoryPrior`,
     one distribution per object, in the order of the scene description.
 
@@ -37,8 +40,13 @@ class KernelPriorSystem(LeafSystem):
         self._config = config if config is not None else KernelPriorConfig()
         self._database = database if database is not None else load_database(
             self._config.database)
-        # Check T now rather than at the first evaluation.
-        self._database.resolve_iterations(self._config.iterations)
+        # The database's cross-validated T and entries for these clouds, unless the config
+        # names them; checked now rather than at the first evaluation.
+        entries, t = self._database.choice(self._config.clouds)
+        self._entries = self._database.resolve_entries(
+            entries if self._config.entries is None else self._config.entries)
+        self._iterations = self._database.resolve_iterations(
+            t if self._config.iterations is None else self._config.iterations)
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description",
             AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
@@ -60,6 +68,7 @@ class KernelPriorSystem(LeafSystem):
     def _calc_category_prior(self, context, output):
         scene: SceneDescription = self._scene_port.Eval(context)
         output.set_value(CategoryPrior(distributions=[
-            self._database.prior(obj.p_W, obj.n_W, obj.labels, t=self._config.iterations,
-                                 n_neighbours=self._config.n_neighbours)
+            self._database.prior(obj.p_W, obj.n_W, obj.labels, t=self._iterations,
+                                 n_neighbours=self._config.n_neighbours,
+                                 entries=self._entries)
             for obj in scene.objects]))
