@@ -7,8 +7,8 @@ episode script as the collection):
 - "exact": the same gripper pose again — does the simulation give the same label twice?
 - "nudged" (`--nudges` of them per grasp): the gripper pose moved by `--nudge-mm` in a random
   direction and turned by `--nudge-deg` about a random axis through the grasp point (the pads'
-  centre). No feature of local shape at the perception's 4 mm resolution can tell these poses
-  apart, so how often their labels differ bounds what any classifier of it can reach.
+  centre). These poses differ far less than the perception's 4 mm resolution, so how often
+  their labels differ bounds what any classifier of local shape can reach.
 
 The ceiling of any classifier on these labels follows from the agreement of the recorded label
 with the nudged ones (`tg_drake.grasping.repeatability`).

@@ -383,7 +383,7 @@ def summary_markdown(r: dict) -> list[str]:
             f"- Label noise: nudged by {rep['nudge_mm']:g} mm / {rep['nudge_deg']:g}°, a grasp's "
             f"label repeats {100 * rep['nudged_agreement']:.1f} % of the time (the same pose: "
             f"{100 * rep['exact_repeat_rate']:.1f} %), so no classifier whose input cannot tell "
-            "such a nudge apart (any feature of a 4 mm cloud) can exceed "
+            "such a nudge apart (a quarter of the cloud's 4 mm spacing) can exceed "
             f"{100 * lo:.0f}–{100 * hi:.0f} % on these labels (section \"Label "
             "repeatability\")."]
     gentle = r.get("label_repeatability_gentle")
@@ -560,7 +560,7 @@ def repeatability_markdown(rep: dict | None) -> list[str]:
         f"were executed again ({rep['n_episodes']} episodes; tools/label_noise.py): once with "
         f"the same gripper pose, and {rep['nudges']} times with the pose moved "
         f"{rep['nudge_mm']:g} mm and turned {rep['nudge_deg']:g}° about random axes through the "
-        "grasp point, a change that no 7 mm pixel of a 4 mm cloud can see.",
+        "grasp point, a change far below the DGI's 7 mm pixels and the cloud's 4 mm spacing.",
         "",
         "| | label repeats |",
         "|---|---|",

@@ -2,7 +2,7 @@
 
 tools/label_noise.py executes recorded grasps again (`tg_drake.grasping.episode`): with the same
 gripper pose, and "nudged" — the pose moved a millimetre and turned a degree (`nudge`), a change
-that no feature of local shape at the perception's 4 mm resolution can see. This module holds the
+far below the perception's 4 mm resolution. This module holds the
 pure parts: the stratified sample, the nudge, and the analysis of the repeated labels.
 
 The ceiling: if a grasp's label is a coin that lands "success" with probability p under nudges,
