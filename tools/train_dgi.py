@@ -324,8 +324,8 @@ def markdown(r: dict) -> str:
         "Top-grasp accuracy: in every scene (an object in one resting pose) the grasp with the",
         "highest P(grasp | local shape) among the scene's executed grasps is taken; it is right",
         "when it held. Scores come from models trained on the other objects (4 folds grouped by",
-        f"object); scenes without any successful grasp ({top['n_scenes_without_positive']}) are "
-        "left out.",
+        "object, γ and C chosen on those objects alone); scenes without any successful grasp "
+        f"({top['n_scenes_without_positive']}) are left out.",
         "",
         "Scenes whose top grasp failed: " + ", ".join(top["wrong_scenes"]) + ".",
         "Local shape cannot see mass: a pan (1–2.5 kg) or a full-size pot held by its handle",
