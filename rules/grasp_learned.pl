@@ -1,5 +1,5 @@
 % LEARNED grasp model: the probabilities of grasp_specific.pl fitted by ProbLog's learning from interpretations (EM, 2 iterations, log-likelihood -1512.80),
-% starting from the hand-written values (worth 2 interpretations as a prior); data: 261 executed grasps of 81 scenes of the training objects (data/learning/grasps.jsonl), 299 interpretations (a grasp that served an afforded task), 50 dropped (no rule for the served part).
+% starting from the hand-written values (worth 2 interpretations as a prior); data: 261 executed grasps of 81 scenes of the training objects (data/learning/grasps.jsonl from `python tools/learn_theory.py --stage collect --seed 0`; summary in docs/results/learning_data.json), 299 interpretations (a grasp that served an afforded task), 50 dropped (no rule for the served part).
 % Made by: python tools/learn_theory.py --stage fit
 % Clauses without data keep their hand-written values. Do not edit: rerun the command (tg_drake/logic/learning.py says what is tunable and why).
 %
