@@ -436,8 +436,17 @@ def write_results(records: list[dict], e0: dict, success: dict, command: str) ->
         lines.append(f"| {a['scene']} | {a['task']} | {a['part'] or '–'}, {a['status']}"
                      f"{' ✓' if a['served'] else ''} | {b['part'] or '–'}, {b['status']}"
                      f"{' ✓' if b['served'] else ''} |")
-    (RESULTS / "learning.md").write_text("\n".join(lines) + "\n")
+    # A hand-written reading of the numbers below the marker survives a regeneration.
+    kept = ""
+    if (RESULTS / "learning.md").is_file():
+        old = (RESULTS / "learning.md").read_text()
+        if READING_MARKER in old:
+            kept = "\n" + old[old.index(READING_MARKER):]
+    (RESULTS / "learning.md").write_text("\n".join(lines) + "\n" + kept)
     return out
+
+
+READING_MARKER = "<!-- reading: written by hand, kept when the tables are regenerated -->"
 
 
 def _points(a, b) -> str:
