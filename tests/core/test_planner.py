@@ -377,3 +377,22 @@ def test_place_variants_turn_the_object_about_the_vertical_through_its_centre():
         np.testing.assert_allclose(V[2, :3], X[2, :3], atol=1e-12)  # heights of the axes kept
         turn = V[:3, :3] @ X[:3, :3].T
         assert np.degrees(np.arctan2(turn[1, 0], turn[0, 0])) == pytest.approx(yaw, abs=1e-9)
+
+
+def test_the_retreat_backs_out_along_the_approach_at_the_place():
+    """With the object turned about the vertical at the place, the gripper's approach turns with
+    it; the retreat follows the approach at the place, not the one at the pick (which dragged a
+    bottle over)."""
+    from tg_drake.planning.planner import _key_poses, _place_variants
+
+    config = PlannerConfig()
+    X_WO = RigidTransform([0.75, 0.1, 0.1]).GetAsMatrix4()
+    X_WG = grasp_pose([0.75, 0.1, 0.12], approach_W=[1, 0, 0], closing_W=[0, 1, 0])
+    X_WO_place = place_pose(X_WO, [0.07, 0.07, 0.2], (0.6, -0.35))
+    for X_place in _place_variants(X_WO_place, config):
+        key = _key_poses(None, X_WG, X_WO, X_place, config)
+        place, retreat = key.X["place"], key.X["retreat"]
+        np.testing.assert_allclose(retreat.translation() - place.translation(),
+                                   -config.retreat_distance * place.rotation().col(1), atol=1e-12)
+        np.testing.assert_allclose(place.translation() + GRASP_POINT * place.rotation().col(1),
+                                   [0.6, -0.35, X_place[2, 3] + 0.02], atol=1e-9)

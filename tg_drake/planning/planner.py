@@ -607,7 +607,9 @@ def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config) -> _KeyPoses:
          "lift": moved(X_WG, up),
          "pre-place": moved(X_WG_place, up),
          "place": X_WG_place,
-         "retreat": moved(X_WG_place, -config.retreat_distance * y_G)}
+         # Back out along the gripper's approach at the place (the object may have been turned
+         # about the vertical there, turning the approach with it).
+         "retreat": moved(X_WG_place, -config.retreat_distance * X_WG_place.rotation().col(1))}
     return _KeyPoses(X, X_OG.inverse(), np.asarray(X_WO_place, float))
 
 
