@@ -351,18 +351,19 @@ def test_a_part_too_flat_for_the_pads_above_the_table_is_refused():
         o.p_W = np.column_stack([0.75 + x.ravel(), y.ravel(), z.ravel()])
         return o
 
+    OPEN = PlannerConfig().open_width
     X = clear_of_table(grasp_pose([0.75, 0.0, 0.0], approach_W=[0, 0, -1],
                                   closing_W=[0, 1, 0]), 0.0)
     # The pads' tips stay TABLE_CLEARANCE above the table: a plate reaches (thickness −
     # clearance) between them.
     for thickness in (0.012, 0.03):
-        assert _depth_between_pads(plate(thickness), X) == pytest.approx(
+        assert _depth_between_pads(plate(thickness), X, OPEN) == pytest.approx(
             thickness - TABLE_CLEARANCE, abs=1e-9)
-    assert _depth_between_pads(plate(0.012), X) < PlannerConfig().min_pad_depth
+    assert _depth_between_pads(plate(0.012), X, OPEN) < PlannerConfig().min_pad_depth
     # Completion mirrored a 6 mm blade up to 18 mm: the points the camera saw decide.
     blade = plate(0.018)
     blade.visible = blade.p_W[:, 2] <= 0.006 + 1e-9
-    assert _depth_between_pads(blade, X) == pytest.approx(0.006 - TABLE_CLEARANCE, abs=1e-9)
+    assert _depth_between_pads(blade, X, OPEN) == pytest.approx(0.006 - TABLE_CLEARANCE, abs=1e-9)
 
 
 def test_place_variants_turn_the_object_about_the_vertical_through_its_centre():

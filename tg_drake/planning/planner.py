@@ -270,7 +270,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             if along:
                 costs[i], reasons[i] = np.inf, _farthest(reasons[i], along)
                 continue
-            depth = _depth_between_pads(target, X_WG)
+            depth = _depth_between_pads(target, X_WG, config.open_width)
             if depth < config.min_pad_depth:
                 costs[i] = np.inf
                 reasons[i] = _farthest(reasons[i], (
@@ -357,7 +357,6 @@ def _place_variants(X_WO_place: np.ndarray, config: PlannerConfig) -> list[np.nd
 PAD_CORNERS_G = np.array([[sx * x, y, sz * 0.01] for sx in (-1, 1) for x in (0.067,)
                           for y in (0.014, 0.096) for sz in (-1, 1)])
 TABLE_CLEARANCE = 0.004  # [m] the open pads' lowest corner above the table top
-GRASP_OPENING = 0.11  # [m] between the open pads' inner faces
 
 
 def clear_of_table(X_WG: np.ndarray, table_z: float) -> np.ndarray | None:
@@ -523,24 +522,12 @@ def _part_width(target: ObjectDescription, part: str, X_WG: np.ndarray) -> float
     return float(2.0 * np.abs(x_B) @ np.asarray(box.half_extents))
 
 
-def _width_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
-    """Twice the largest |x_G| of the target's perceived points in the slab the open finger pads
-    sweep (along the approach over the pads' length, across their width, out to their outer
-    faces): the opening the grasp needs. inf when no point lies there (nothing to grasp)."""
-    p_G = (np.asarray(target.p_W, float) - X_WG[:3, 3]) @ X_WG[:3, :3]
-    lo, hi = PAD_CORNERS_G[:, 1].min(), PAD_CORNERS_G[:, 1].max()
-    half_width = PAD_CORNERS_G[:, 2].max()
-    outer = PAD_CORNERS_G[:, 0].max()
-    inside = ((p_G[:, 1] >= lo) & (p_G[:, 1] <= hi) & (np.abs(p_G[:, 2]) <= half_width)
-              & (np.abs(p_G[:, 0]) <= outer))
-    return float(2.0 * np.abs(p_G[inside, 0]).max()) if inside.any() else float("inf")
-
-
-def _slab_points(target: ObjectDescription, X_WG: np.ndarray, *, visible_only: bool = False
-                 ) -> np.ndarray:
-    """The target's perceived points in G that lie between the open finger pads: along the
-    approach over the pads' length, across their width, inside their inner faces (only the
-    points the camera saw, not completed ones, with `visible_only`)."""
+def _slab_points(target: ObjectDescription, X_WG: np.ndarray, *, reach: float,
+                 visible_only: bool = False) -> np.ndarray:
+    """The target's perceived points in G in the slab the open finger pads sweep: along the
+    approach over the pads' length, across their width, and within `reach` of the grasp point
+    along the closing axis (only the points the camera saw, not completed ones, with
+    `visible_only`)."""
     p_W = np.asarray(target.p_W, float)
     visible = np.asarray(target.visible, bool)
     if visible_only and len(visible) == len(p_W):
@@ -549,21 +536,30 @@ def _slab_points(target: ObjectDescription, X_WG: np.ndarray, *, visible_only: b
     lo, hi = PAD_CORNERS_G[:, 1].min(), PAD_CORNERS_G[:, 1].max()
     inside = ((p_G[:, 1] >= lo) & (p_G[:, 1] <= hi)
               & (np.abs(p_G[:, 2]) <= PAD_CORNERS_G[:, 2].max())
-              & (np.abs(p_G[:, 0]) <= GRASP_OPENING / 2))
+              & (np.abs(p_G[:, 0]) <= reach))
     return p_G[inside]
 
 
-def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
-    """How far along the approach the object reaches between the pads [m]: from the pads' tips
-    back to its nearest point there (inf when perception gave no points: nothing to check).
+def _width_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
+    """Twice the largest |x_G| of the target's perceived points in the slab the open pads sweep,
+    out to their outer faces (a point under a pad counts): the opening the grasp needs. inf when
+    no point lies there (nothing to grasp)."""
+    p = _slab_points(target, X_WG, reach=PAD_CORNERS_G[:, 0].max())
+    return float(2.0 * np.abs(p[:, 0]).max()) if len(p) else float("inf")
+
+
+def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float
+                        ) -> float:
+    """How far along the approach the object reaches between the open pads [m]: from the pads'
+    tips back to its nearest point there (inf when perception gave no points: nothing to check).
 
     Measured on the points the camera saw where there are any: symmetry completion mirrors a
     flat blade about the handle's axis, which makes a 6 mm spatula blade look 16 mm tall."""
     if len(target.p_W) == 0:
         return float("inf")
-    p = _slab_points(target, X_WG, visible_only=True)
+    p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=True)
     if not len(p):
-        p = _slab_points(target, X_WG)
+        p = _slab_points(target, X_WG, reach=open_width / 2)
     return float(PAD_CORNERS_G[:, 1].max() - p[:, 1].min()) if len(p) else 0.0
 
 
