@@ -139,7 +139,8 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samplings", type=int, default=3,
                         help="ground-truth samplings per library object")
-    parser.add_argument("--spacing", type=float, default=SPACING, help="voxel size [m]")
+    parser.add_argument("--spacing", type=float, default=SPACING,
+                        help="voxel size as a fraction of the object's size")
     parser.add_argument("--seed", type=int, default=0, help="seed of sampling and projections")
     parser.add_argument("--out", type=Path, default=OUT, help="output .npz")
     parser.add_argument("--check", action="store_true",
@@ -153,7 +154,7 @@ def main(argv=None) -> int:
           f"perceived views; {len(summary['perception_failures'])} views without an object, "
           f"{len(summary['too_small'])} too small), {summary['points_min']}–"
           f"{summary['points_max']} points (median {summary['points_median']:.0f}) at "
-          f"{args.spacing * 1e3:.1f} mm")
+          f"a spacing of {args.spacing:g} of the object's size")
     c = summary["chosen"]
     print(f"cross-validated for perceived queries: w = {c['w']:g}, entries {c['entries']}, "
           f"T = {c['T']}: "

@@ -197,7 +197,7 @@ def markdown(result: dict) -> str:
         "",
         f"S_SYN analogue: {syn['n_objects']} objects × {result['samplings']} ground-truth "
         f"samplings = {syn['n_queries']} queries per seed against the other objects' samplings, "
-        f"seeds {result['seeds']}, voxel {result['spacing'] * 1e3:.0f} mm "
+        f"seeds {result['seeds']}, voxel {result['spacing']:g} of the object's size "
         f"({syn['points_min']}–{syn['points_max']} points, median {syn['points_median']:.0f}, "
         f"first seed).",
         "",
@@ -315,7 +315,8 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
     parser.add_argument("--samplings", type=int, default=3, help="clouds per object")
-    parser.add_argument("--spacing", type=float, default=SPACING, help="voxel size [m]")
+    parser.add_argument("--spacing", type=float, default=SPACING,
+                        help="voxel size as a fraction of the object's size")
     parser.add_argument("--database", type=Path, default=None,
                         help="kernel database of the perceived evaluation (default: shipped)")
     parser.add_argument("--bench", action="store_true",

@@ -10,15 +10,17 @@ import scipy.sparse as sp
 
 from tg_drake.errors import KernelError
 from tg_drake.kernels import synthetic
-from tg_drake.kernels.database import KernelDatabase
+from tg_drake.kernels.database import KernelDatabase, prepare_cloud
 from tg_drake.kernels.graph import (
-    LabelledCloud, cloud_transition, knn_graph, transition_matrix, validate_cloud, voxel_resample)
+    LabelledCloud, cloud_transition, knn_graph, object_size, size_normalised, transition_matrix,
+    validate_cloud, voxel_resample)
 from tg_drake.kernels.prior import category_priors, is_correct, true_category_rank
 from tg_drake.kernels.propagation import (
     LshProjections, graph_features, lsh, normalise, one_hot, propagation_hashes)
 from tg_drake.types import CATEGORIES
 
-SPACING = 0.008  # [m] voxel size of the test clouds: a few hundred points per object, fast.
+SPACING = 0.05  # voxel size of the test clouds as a fraction of the object's size: a few
+# hundred points per object, fast.
 
 
 def _shapes(rng):
@@ -41,8 +43,8 @@ def raw_clouds():
 
 @pytest.fixture(scope="module")
 def clouds(raw_clouds):
-    """The clouds resampled to SPACING, as the database holds them."""
-    return [voxel_resample(c, SPACING) for c in raw_clouds]
+    """The clouds scaled to unit size and resampled to SPACING, as the database holds them."""
+    return [prepare_cloud(c.points, c.normals, c.labels, spacing=SPACING) for c in raw_clouds]
 
 
 @pytest.fixture(scope="module")
@@ -137,10 +139,10 @@ def test_database_rejects_bad_queries(clouds, projections):
         db.similarities(c.points, c.normals, c.labels, t=16)
     with pytest.raises(KernelError, match="unknown database object 'zz'; allowed: a, b"):
         db.prior(c.points, c.normals, c.labels, exclude_object="zz")
-    # Six points within one voxel collapse to one point.
-    tiny = np.random.default_rng(0).random((6, 3)) * 1e-4
-    with pytest.raises(KernelError, match="after resampling at 8.0 mm is too small"):
-        db.prior(tiny, np.tile([0, 0, 1.0], (6, 1)), np.zeros(6, int))
+    # Four of six points at one place: three voxels are left, the graph needs five points.
+    few = np.array([[0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], [1e-2, 0, 0], [0, 1e-2, 0]])
+    with pytest.raises(KernelError, match="after resampling at 0.050 of its size is too small"):
+        db.prior(few, np.tile([0, 0, 1.0], (6, 1)), np.zeros(6, int))
 
 
 # -- LSH and propagation ----------------------------------------------------------------------
@@ -316,6 +318,29 @@ def test_resampling_follows_a_moved_cloud(raw_clouds):
     np.testing.assert_allclose(b.points - a.points, shift, rtol=0, atol=1e-15)
 
 
+def test_object_size_is_the_largest_principal_extent_whatever_the_turn():
+    rng = np.random.default_rng(5)
+    box = synthetic.box(size=(0.07, 0.03, 0.2), n=4000, rng=rng)
+    from scipy.spatial.transform import Rotation
+    R = Rotation.random(random_state=1).as_matrix()
+    # 2e-3 relative: the principal axes of a sampled box tilt a little off its edges.
+    assert object_size(box.points) == pytest.approx(0.2, rel=2e-3)
+    assert object_size(box.points @ R.T + 0.3) == pytest.approx(object_size(box.points), rel=1e-12)
+    assert object_size(size_normalised(box).points) == pytest.approx(1.0, rel=1e-12)
+    with pytest.raises(KernelError, match="no extent"):
+        size_normalised(LabelledCloud(np.zeros((6, 3)), box.normals[:6], box.labels[:6]))
+
+
+def test_a_scaled_copy_of_a_cloud_has_the_same_prior(database, raw_clouds):
+    # The paper's normalised kernel is meant to be independent of the object's scale: a cup
+    # 1.7 times as large is the same graph after size normalisation and resampling.
+    c = raw_clouds[3]
+    big = database.similarities(1.7 * c.points, c.normals, c.labels, t=9)
+    # 1e-9: the scaled coordinates round differently, not enough to move a point to another voxel.
+    np.testing.assert_allclose(big, database.similarities(c.points, c.normals, c.labels, t=9),
+                               rtol=1e-9)
+
+
 def test_leave_one_object_out_drops_all_samplings_of_the_held_out_object():
     from tg_drake.kernels.evaluation import best, leave_one_object_out, random_score
 
@@ -343,11 +368,12 @@ def test_leave_one_object_out_drops_all_samplings_of_the_held_out_object():
 # -- perceived entries and their leave-one-object-out evaluation ------------------------------
 
 @pytest.fixture(scope="module")
-def mixed_database(clouds, projections):
+def mixed_database(clouds, raw_clouds, projections):
     """Each shape twice: once as a ground-truth sampling, once (another grid) as a "perceived"
     view of the same object; only "can" has two objects."""
     rng = np.random.default_rng(11)
-    views = [voxel_resample(c, SPACING, offset=rng.random(3) * SPACING) for c in clouds]
+    views = [voxel_resample(size_normalised(c), SPACING, offset=rng.random(3) * SPACING)
+             for c in raw_clouds]
     ids = ["can1", "can2", "cup1", "cup2", "hammer1", "bottle1"]
     cats = [CATEGORIES.index(c) for c in ("can", "can", "cup", "cup", "hammer", "bottle")]
     return KernelDatabase.build(
@@ -378,9 +404,9 @@ def test_mixed_database_round_trip(mixed_database):
     assert (loaded.entries_default, loaded.t_default) == ("perceived", 3)
 
 
-def test_member_profile_equals_the_query_of_the_same_cloud(mixed_database, clouds):
-    # Database graph 1 is clouds[1] as built (already on the database's grid).
-    c = clouds[1]
+def test_member_profile_equals_the_query_of_the_same_cloud(mixed_database, raw_clouds):
+    # Database graph 1 is raw_clouds[1] as a query prepares it (scaled, resampled).
+    c = raw_clouds[1]
     np.testing.assert_allclose(mixed_database.member_profile([1])[:, 0],
                                mixed_database.similarity_profile(c.points, c.normals, c.labels),
                                rtol=1e-12)

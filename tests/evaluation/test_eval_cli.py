@@ -62,7 +62,8 @@ def test_a_crashed_case_is_a_failure_and_can_be_retried(tiny_run, tmp_path):
     assert eval_(TINY, "--out", tmp_path, "--workers", "0") == 0
     tables = json.loads((tmp_path / "tables.json").read_text())
     assert tables["n_errors"] == 1 and tables["category"]["syn"]["n"] == 3
-    assert tables["category"]["syn"]["manifolds"] <= 100 * 2 / 3  # the hammer counts as wrong
+    # The hammer counts as wrong (tables round to 0.01 %).
+    assert tables["category"]["syn"]["manifolds"] <= round(100 * 2 / 3, 2)
     assert eval_(TINY, "--out", tmp_path, "--workers", "0", "--retry-errors") == 0
     assert json.loads((tmp_path / "tables.json").read_text())["n_errors"] == 0
 

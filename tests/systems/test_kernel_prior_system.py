@@ -7,13 +7,12 @@ import pytest
 
 from tg_drake.errors import KernelError
 from tg_drake.kernels import synthetic
-from tg_drake.kernels.database import KernelDatabase, KernelPriorConfig
-from tg_drake.kernels.graph import voxel_resample
+from tg_drake.kernels.database import KernelDatabase, KernelPriorConfig, prepare_cloud
 from tg_drake.kernels.propagation import LshProjections
 from tg_drake.systems.kernel_prior_system import KernelPriorSystem
 from tg_drake.types import CATEGORIES, CategoryPrior, ObjectDescription, SceneDescription
 
-SPACING = 0.008  # [m]
+SPACING = 0.05  # voxel size as a fraction of the object's size.
 
 
 def _object(cloud, p_WO) -> ObjectDescription:
@@ -39,7 +38,8 @@ def database():
     clouds, ids, cats = [], [], []
     for name, make in makers.items():
         for i in range(3):
-            clouds.append(voxel_resample(make(), SPACING))
+            c = make()
+            clouds.append(prepare_cloud(c.points, c.normals, c.labels, spacing=SPACING))
             ids.append(f"{name}{i}")
             cats.append(CATEGORIES.index(name))
     return KernelDatabase.build(clouds, ids, cats, spacing=SPACING, t_default=6,
@@ -124,8 +124,8 @@ def test_the_database_choice_for_the_kind_of_cloud_is_used():
     # One "ground_truth" and one "perceived" graph per object; the database chose the perceived
     # entries at T = 2 for perceived clouds and all entries at T = 5 for ground-truth samplings.
     rng = np.random.default_rng(4)
-    clouds = [voxel_resample(synthetic.cylinder(radius=0.033, height=0.12, n=3000, rng=rng),
-                             SPACING) for _ in range(4)]
+    clouds = [synthetic.cylinder(radius=0.033, height=0.12, n=3000, rng=rng) for _ in range(4)]
+    clouds = [prepare_cloud(c.points, c.normals, c.labels, spacing=SPACING) for c in clouds]
     db = KernelDatabase.build(
         clouds, ["can0", "can0", "can1", "can1"], [CATEGORIES.index("can")] * 4,
         spacing=SPACING, projections=LshProjections.sample(rng=np.random.default_rng(0)),

@@ -21,13 +21,14 @@ import scipy.sparse as sp
 
 from tg_drake.errors import KernelError, unknown_name
 from tg_drake.kernels.graph import (
-    K_NEIGHBOURS, LabelledCloud, cloud_transition, validate_cloud, voxel_resample)
+    K_NEIGHBOURS, LabelledCloud, cloud_transition, size_normalised, validate_cloud,
+    voxel_resample)
 from tg_drake.kernels.prior import N_NEIGHBOURS, category_priors
 from tg_drake.kernels.propagation import (
     FeatureCounts, LshProjections, graph_features, propagation_hashes)
 from tg_drake.types import CATEGORIES, PART_LABELS, CategoryDistribution
 
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3  # 3: clouds scaled to unit size before resampling (spacing relative).
 SOURCES = ("ground_truth", "perceived")  # where a database graph came from.
 # Which database graphs a query is compared with: every graph, or those of one source.
 ENTRIES = ("all",) + SOURCES
@@ -50,14 +51,15 @@ class KernelPriorConfig:
 
 def prepare_cloud(points, normals, labels, *, spacing: float, k: int = K_NEIGHBOURS
                   ) -> LabelledCloud:
-    """Validates a cloud and resamples it to `spacing` [m], as queries and perceived database
-    entries are (the grid starts at the cloud's lowest corner)."""
-    cloud = validate_cloud(points, normals, labels, k=k)
+    """Validates a cloud, scales it to unit size (`graph.size_normalised`) and resamples it to
+    `spacing` (a fraction of the object's size), as queries and perceived database entries are
+    (the grid starts at the cloud's lowest corner)."""
+    cloud = size_normalised(validate_cloud(points, normals, labels, k=k))
     resampled = voxel_resample(cloud, spacing)
     if resampled.points.shape[0] < k + 1:
         raise KernelError(
             f"a cloud of {resampled.points.shape[0]} point(s) after resampling at "
-            f"{spacing * 1e3:.1f} mm is too small: the k-nn graph with k = {k} "
+            f"{spacing:.3f} of its size is too small: the k-nn graph with k = {k} "
             f"needs at least {k + 1} points")
     return resampled
 
@@ -70,7 +72,8 @@ class KernelDatabase:
     categories: np.ndarray  # (G,) int: index into CATEGORIES.
     features: FeatureCounts  # φ(G_t) for t = 0..t_max.
     projections: LshProjections  # the LSH projections of database and queries.
-    spacing: float  # [m] voxel size clouds are resampled to before their graph is built.
+    spacing: float  # voxel size clouds are resampled to before their graph is built, as a
+    # fraction of the cloud's size (clouds are scaled to a largest principal extent of 1).
     k: int = K_NEIGHBOURS  # neighbours per node in the k-nn graph.
     t_default: int = 0  # T used when a query gives none.
     library_fingerprint: str = ""  # of the object library the graphs were sampled from.

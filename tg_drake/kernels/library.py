@@ -7,10 +7,10 @@ database graphs, as the paper compared real scans with real scans.
 
 Each sampling of an object draws points uniformly on its mesh (three times denser than the
 database spacing), turns the object by a random rotation and keeps one point per voxel of
-`SPACING` on a randomly shifted grid: a near-uniform cloud with ground-truth part labels and
-outward normals, at about the density perception produces (it averages visible points per 4 mm
-voxel; the prior resamples its clouds to `SPACING` too). Different samplings of one object differ
-in where the points fall, so they are different graphs of the same shape.
+`SPACING` of the object's size on a randomly shifted grid (the cloud scaled to unit size first,
+`graph.size_normalised`): a near-uniform cloud with ground-truth part labels and outward normals;
+the prior scales and resamples its query clouds the same way. Different samplings of one object
+differ in where the points fall, so they are different graphs of the same shape.
 """
 
 from __future__ import annotations
@@ -20,20 +20,23 @@ import hashlib
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from tg_drake.kernels.graph import LabelledCloud, voxel_resample
+from tg_drake.kernels.graph import LabelledCloud, size_normalised, voxel_resample
 from tg_drake.types import CATEGORIES
 
-SPACING = 0.008  # [m] database voxel size: ~160 (small knives) to ~3000 (pans) points per object.
+SPACING = 0.05  # database voxel size as a fraction of the object's size (clouds are scaled to a
+# largest principal extent of 1): ~200 (knives) to ~1,300 (pots) points per object.
 OVERSAMPLING = 3.0  # surface samples are drawn at SPACING / OVERSAMPLING before resampling.
 
 
 def sample_object(obj, *, spacing: float = SPACING, rng: np.random.Generator) -> LabelledCloud:
-    """One resampled labelled cloud of a library object (a `tg_drake.objects.LibraryObject`)."""
+    """One resampled labelled cloud of a library object (a `tg_drake.objects.LibraryObject`),
+    scaled to unit size (`graph.size_normalised`); `spacing` is relative to that size."""
     from tg_drake.objects import sample_surface
 
-    p, n, labels = sample_surface(obj, spacing=spacing / OVERSAMPLING, rng=rng)
+    size = float(max(obj.extents))
+    p, n, labels = sample_surface(obj, spacing=size * spacing / OVERSAMPLING, rng=rng)
     R = Rotation.random(rng=rng).as_matrix()
-    cloud = LabelledCloud(p @ R.T, n @ R.T, labels)
+    cloud = size_normalised(LabelledCloud(p @ R.T, n @ R.T, labels))
     return voxel_resample(cloud, spacing, offset=rng.random(3) * spacing)
 
 
