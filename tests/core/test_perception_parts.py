@@ -171,3 +171,24 @@ def test_rim_pregrasps_on_a_wide_upright_top_only():
     rx = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # 90° about x
     sideways = make_transform(rx, [0.7, 0.1, 0.08])
     assert rim_pregrasps(sideways, np.array([0.08, 0.08, 0.01]), cfg).shape == (0, 4, 4)
+
+
+def test_a_long_part_also_gets_grasps_along_it_closing_across_it():
+    from tg_drake.perception.config import PregraspConfig
+    from tg_drake.perception.pregrasp import along_pregrasps
+
+    cfg = PregraspConfig()
+    X_WB = np.eye(4)
+    X_WB[:3, 3] = [0.6, 0.1, 0.015]
+    handle = np.array([0.12, 0.015, 0.015])  # half extents: 24 cm along x
+    X = along_pregrasps(X_WB, handle, cfg)
+    # The four long faces, each with its pose closing across x, shifted both ways.
+    assert X.shape == (8, 4, 4)
+    assert np.all(np.abs(X[:, :3, 0] @ [1.0, 0.0, 0.0]) < 1e-12)
+    p_grasp = X[:, :3, 3] + np.einsum("nij,j->ni", X[:, :3, :3], WSG_GRASP_POINT_G)
+    shift = cfg.along_fraction * handle[0]
+    np.testing.assert_allclose(np.sort(np.unique(np.round(p_grasp[:, 0], 9))),
+                               [0.6 - shift, 0.6 + shift], atol=1e-12)
+    # A short or stubby box gets none.
+    assert along_pregrasps(X_WB, np.array([0.03, 0.015, 0.015]), cfg).shape == (0, 4, 4)
+    assert along_pregrasps(X_WB, np.array([0.06, 0.04, 0.015]), cfg).shape == (0, 4, 4)

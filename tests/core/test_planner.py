@@ -397,3 +397,57 @@ def test_the_retreat_backs_out_along_the_approach_at_the_place():
                                    -config.retreat_distance * place.rotation().col(1), atol=1e-12)
         np.testing.assert_allclose(place.translation() + GRASP_POINT * place.rotation().col(1),
                                    [0.6, -0.35, X_place[2, 3] + 0.02], atol=1e-9)
+
+
+def test_torsion_lever_is_the_weight_arm_about_the_closing_axis():
+    from tg_drake.planning.planner import torsion_lever
+
+    # Top-down across a handle along world x (fingers closing along y): a weight 0.1 m further
+    # along the handle turns the object about the closing axis with a 0.1 m lever.
+    X = grasp_pose([0.7, 0.0, 0.02], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
+    assert torsion_lever(X, [0.8, 0.0, 0.02]) == pytest.approx(0.1, abs=1e-12)
+    # A weight along the closing axis (a rim grasp: the pan's middle beyond the wall), or
+    # straight below, presses on the pads' faces instead: no lever about the closing axis.
+    assert torsion_lever(X, [0.7, 0.1, 0.02]) == pytest.approx(0.0, abs=1e-12)
+    assert torsion_lever(X, [0.7, 0.0, -0.1]) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_within_a_part_the_grasp_nearer_the_weight_is_tried_first():
+    # A hammer-like handle along x; its points (and centroid) lie towards +x. Two top-down
+    # grasps across it with equal scores: the planner plans the one nearer the centroid.
+    handle = box_object([0.65, 0.0, 0.015], [0.24, 0.03, 0.03], parts=("handle",))
+    x = np.linspace(0.55, 0.77, 60)
+    g = np.linspace(-0.015, 0.015, 5)
+    xx, yy, zz = np.meshgrid(x, g, g + 0.015)
+    handle.p_W = np.column_stack([xx.ravel(), yy.ravel(), zz.ravel()])
+    handle.n_W = np.tile([0.0, 0.0, 1.0], (len(handle.p_W), 1))
+    handle.visible = np.ones(len(handle.p_W), bool)
+    far = grasp_pose([0.57, 0.0, 0.02], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
+    near = grasp_pose([0.69, 0.0, 0.02], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
+    result = plan_pick_and_place(candidates([(far, "handle"), (near, "handle")], [0.8, 0.8]),
+                                 target=handle, place_xy=[0.5, -0.3])
+    assert result.status == "planned", result.reason
+    assert result.candidate == 1
+
+
+def test_an_object_past_both_pads_is_refused_one_past_a_single_pad_is_not():
+    from tg_drake.planning.planner import _extent_along_closing
+
+    config = PlannerConfig()
+    half = (config.open_width - config.release_gap) / 2
+    X = grasp_pose([0.7, 0.0, 0.03], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
+    # A can lying along x, 113 mm long, taken at its middle with the fingers along its axis.
+    can = box_object([0.7, 0.0, 0.03], [0.113, 0.055, 0.055], parts=("middle",))
+    t = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    xs = np.linspace(-0.0565, 0.0565, 30)
+    can.p_W = np.array([[0.7 + x, 0.0275 * np.cos(a), 0.03 + 0.0275 * np.sin(a)]
+                        for x in xs for a in t])
+    lo, hi = _extent_along_closing(can, X, config.release_band)
+    assert (lo, hi) == pytest.approx((-0.0565, 0.0565), abs=1e-9)
+    assert -lo > half and hi > half
+    # A cup's handle reaching past one pad only: the fingers open clear of the other side.
+    cup = box_object([0.7, 0.0, 0.03], [0.105, 0.075, 0.06], parts=("middle",))
+    cup.p_W = can.p_W[np.abs(can.p_W[:, 0] - 0.7) <= 0.0375] + [0.0, 0.0, 0.0]
+    cup.p_W = np.vstack([cup.p_W, [[0.7 + 0.0675, 0.0, 0.03]]])  # the handle's far end
+    lo, hi = _extent_along_closing(cup, X, config.release_band)
+    assert hi > half and not -lo > half

@@ -96,6 +96,12 @@ class PregraspConfig:
     # finger stays high, clear of the container's floor.
     rim_wall: float = 0.004  # the grasp point lies this far inside the outer radius [m] (about
     # half a wall's thickness).
+    # Grasps along a long part (ours, beyond the paper's face centres): a part box whose longest
+    # side is at least `along_min_length` and twice its others (a handle) also gets the face
+    # grasps that close across it shifted along it by ± `along_fraction` of its half length, so
+    # that the planner can hold a hammer near its heavy head rather than at its handle's middle.
+    along_min_length: float = 0.08  # [m]
+    along_fraction: float = 0.5
 
 
 @dataclass

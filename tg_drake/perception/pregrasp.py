@@ -90,12 +90,37 @@ def rim_pregrasps(X_WB: np.ndarray, half_extents: np.ndarray,
     return np.array(out)
 
 
+def along_pregrasps(X_WB: np.ndarray, half_extents: np.ndarray,
+                    cfg: PregraspConfig | None = None) -> np.ndarray:
+    """Face grasps shifted along a long part box (a handle): for each face parallel to its long
+    axis, the pose whose fingers close across that axis, moved along it by ± `along_fraction`
+    of the half length. (0, 4, 4) when the box is not long enough (`along_min_length`, twice its
+    other sides). Order: face by face, −shift then +shift."""
+    cfg = cfg or PregraspConfig()
+    h = np.asarray(half_extents, float)
+    k = int(np.argmax(h))
+    if 2 * h[k] < cfg.along_min_length or h[k] < 2 * np.delete(h, k).max():
+        return np.zeros((0, 4, 4))
+    X_face = box_pregrasps(X_WB, h, cfg)
+    axis = np.asarray(X_WB, float)[:3, k]
+    out = []
+    for j, X in enumerate(X_face):
+        if FACE_AXIS[j // 2] == k or abs(X[:3, 0] @ axis) > 0.5:
+            continue  # an end face, or fingers closing along the length
+        for sign in (-1.0, 1.0):
+            Y = X.copy()
+            Y[:3, 3] += sign * cfg.along_fraction * h[k] * axis
+            out.append(Y)
+    return np.asarray(out).reshape(-1, 4, 4)
+
+
 def part_pregrasps(boxes: dict[str, tuple[np.ndarray, np.ndarray]], part_index,
                    cfg: PregraspConfig | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Pre-grasps of every part box: ((M, 4, 4) X_WG, (M,) part labels).
 
     `boxes` maps a part name to (X_WB, half extents); `part_index` maps a name to its label. The
-    twelve box-face pre-grasps per part come first, then the rim grasps of a wide upright top.
+    twelve box-face pre-grasps per part come first, then the rim grasps of a wide upright top,
+    then the grasps along long parts (`along_pregrasps`), part by part.
     """
     if not boxes:
         return np.zeros((0, 4, 4)), np.zeros(0, int)
@@ -106,4 +131,8 @@ def part_pregrasps(boxes: dict[str, tuple[np.ndarray, np.ndarray]], part_index,
         rim = rim_pregrasps(*boxes["top"], cfg)
         X = np.concatenate([X, rim])
         labels = np.concatenate([labels, np.full(len(rim), part_index("top"))])
+    for name, (X_WB, h) in boxes.items():
+        extra = along_pregrasps(X_WB, h, cfg)
+        X = np.concatenate([X, extra])
+        labels = np.concatenate([labels, np.full(len(extra), part_index(name))])
     return X, labels

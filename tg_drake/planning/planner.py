@@ -73,6 +73,9 @@ class PlannerConfig:
     # slowly (open → 0 over close_duration) so that they meet a light object gently; and back
     # closed_width → 0 at release, before opening over open_duration.
     width_margin: float = 0.01  # [m] a part must be this much narrower than the opening.
+    release_gap: float = 0.005  # [m] an object reaching past both open pads, less this gap
+    # (within `release_band` of the grasp point across the pads), could not be let go.
+    release_band: float = 0.03  # [m]
     close_duration: float = 0.8  # [s] opening → closed command ramp (scripted.py's timing).
     settle_duration: float = 0.4  # [s] hold after closing, before lifting.
     open_duration: float = 0.5  # [s] closed → open at release.
@@ -90,11 +93,16 @@ class PlannerConfig:
     min_pad_depth: float = 0.01  # [m] how far along the pads (the approach) the object must
     # reach between them: a knife's 12 mm blade lying flat rises only 7 mm above the pads'
     # lowest point (TABLE_CLEARANCE) and was pressed out of the fingers.
+    torsion_length: float = 0.1  # [m] within a part, candidates are tried in the order of
+    # score × exp(−ℓ / torsion_length), ℓ the lever about the closing axis of the object's
+    # weight at its perceived centroid (`torsion_lever`): the pads resist that turn by friction
+    # alone, and a hammer held at the middle of its handle turned out of them while carried.
     max_length_ratio: float = 2.0  # fingers do not close along a part's length when it is this
     # many times longer than its other extents (a knife's handle, taken end to end, slipped out).
     place_yaws: tuple = (0.0, 60.0, -60.0, 120.0, -120.0, 180.0)  # [deg] turns of the object
     # about the vertical tried at the place, in order (the first one that can be planned).
-    max_candidates_per_part: int = 12  # candidates examined per part before giving up on it.
+    max_candidates_per_part: int = 12  # candidates per part that reach the inverse kinematics
+    # before the part is given up (those the cheap geometric checks refuse do not count).
     # A side grasp (approach within 30° of horizontal) is also tried tilted downwards about the
     # closing axis through its grasp point by these angles [deg]: the fingers still close across
     # the same part, and the wrist rises clear of the table (horizontal grasps low on an object
@@ -226,6 +234,15 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             parts_order.append(name)
     if max_parts is not None:
         parts_order = parts_order[:max_parts]
+    # Within a part, prefer grasps about which the weight turns the object least.
+    centroid = np.asarray(target.p_W, float).mean(axis=0) if len(target.p_W) else None
+    if centroid is not None and config.torsion_length > 0:
+        steady = {i: score[i] * np.exp(-torsion_lever(np.asarray(candidates.X_WG[i], float),
+                                                      centroid) / config.torsion_length)
+                  for i in order}
+        rank = {name: r for r, name in enumerate(parts_order)}
+        order = sorted(order, key=lambda i: (
+            rank.get(PART_LABELS[int(candidates.parts[i])], len(rank)), -steady[i]))
     if not parts_order:
         return PlanResult("unreachable", None, costs, tuple(reasons), {}, (),
                           "no candidate grasps left to try", time.perf_counter() - t_start)
@@ -247,10 +264,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         part = PART_LABELS[int(candidates.parts[i])]
         if part not in tried or tried[part] >= config.max_candidates_per_part:
             continue
-        tried[part] += 1
         part_reachable.setdefault(part, False)
         part_pickable.setdefault(part, False)
-        found = False
+        found = counted = False
         variants = approach_variants(np.asarray(candidates.X_WG[i], float), config,
                                      table_z=table_z)
         if not variants:
@@ -266,6 +282,20 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 reasons[i] = _farthest(reasons[i], f"{part} is {width:.3f} m across the fingers; "
                                                    f"the WSG opens {config.open_width} m")
                 continue
+            # The part may fit while the object around it does not: a can lying on its side,
+            # taken at its middle with the fingers along its 113 mm axis, is held by its end
+            # caps and stays wedged between the fingers opened to 110 mm at the release. Only
+            # an object past both pads is refused: past one (a cup's handle, a bowl's far wall
+            # in a rim grasp) the fingers still open clear of it.
+            lo, hi = _extent_along_closing(target, X_WG, config.release_band)
+            half = (config.open_width - config.release_gap) / 2
+            if -lo > half and hi > half:
+                costs[i] = np.inf
+                reasons[i] = _farthest(reasons[i], (
+                    f"the object reaches past both pads ({hi - lo:.3f} m along the closing axis "
+                    f"there; its {part} {width:.3f} m): the WSG, open to {config.open_width} m, "
+                    "could not let go"))
+                continue
             along = _closes_along_length(target, part, X_WG, config)
             if along:
                 costs[i], reasons[i] = np.inf, _farthest(reasons[i], along)
@@ -277,6 +307,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                     f"only {depth * 1000:.0f} mm of the object reaches between the pads (at least "
                     f"{config.min_pad_depth * 1000:.0f} mm): too flat to pick up from the table"))
                 continue
+            if not counted:  # this candidate reaches the inverse kinematics
+                tried[part] += 1
+                counted = True
             for X_WO_place_yawed in _place_variants(X_WO_place, config):
                 key = _key_poses(arms, X_WG, X_WO, X_WO_place_yawed, config)
                 below = [n for n in ("pre-grasp", "grasp")
@@ -548,6 +581,17 @@ def _width_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
     return float(2.0 * np.abs(p[:, 0]).max()) if len(p) else float("inf")
 
 
+def _extent_along_closing(target: ObjectDescription, X_WG: np.ndarray, band: float
+                          ) -> tuple[float, float]:
+    """(lowest, highest) x_G [m] of the target's perceived points (completed ones too: the camera
+    misses a far end) within the pads' length along the approach and within `band` of the grasp
+    point across the pads; (0, 0) when there are none."""
+    p_G = (np.asarray(target.p_W, float) - X_WG[:3, 3]) @ X_WG[:3, :3]
+    lo, hi = PAD_CORNERS_G[:, 1].min(), PAD_CORNERS_G[:, 1].max()
+    x = p_G[(p_G[:, 1] >= lo) & (p_G[:, 1] <= hi) & (np.abs(p_G[:, 2]) <= band), 0]
+    return (float(x.min()), float(x.max())) if len(x) else (0.0, 0.0)
+
+
 def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float
                         ) -> float:
     """How far along the approach the object reaches between the open pads [m]: from the pads'
@@ -561,6 +605,14 @@ def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray, open_width:
     if not len(p):
         p = _slab_points(target, X_WG, reach=open_width / 2)
     return float(PAD_CORNERS_G[:, 1].max() - p[:, 1].min()) if len(p) else 0.0
+
+
+def torsion_lever(X_WG: np.ndarray, p_WC: np.ndarray) -> float:
+    """|x_G · ((p_C − p_grasp) × z_W)| [m]: the lever of a weight at p_WC about the gripper's
+    closing axis x_G through the grasp point. The pads resist a turn about x_G by friction over
+    their small contact patch only; a turn about the other axes presses on their whole face."""
+    p_grasp = X_WG[:3, 3] + GRASP_DEPTH * X_WG[:3, 1]
+    return float(abs(X_WG[:3, 0] @ np.cross(np.asarray(p_WC, float) - p_grasp, [0.0, 0.0, 1.0])))
 
 
 def _closes_along_length(target: ObjectDescription, part: str, X_WG: np.ndarray,
