@@ -451,3 +451,20 @@ def test_an_object_past_both_pads_is_refused_one_past_a_single_pad_is_not():
     cup.p_W = np.vstack([cup.p_W, [[0.7 + 0.0675, 0.0, 0.03]]])  # the handle's far end
     lo, hi = _extent_along_closing(cup, X, config.release_band)
     assert hi > half and not -lo > half
+
+
+def test_a_grasp_far_from_the_weight_across_the_lever_is_refused():
+    # A pan-like object: its points (and centroid) around (0.7, 0, 0.03); a handle grasp 0.2 m
+    # out along x, the fingers closing along y: the weight turns it about the closing axis with
+    # a 0.2 m lever, which the pads resist by friction alone.
+    pan = box_object([0.9, 0.0, 0.03], [0.12, 0.03, 0.03], parts=("handle",))
+    t = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    r = np.linspace(0.0, 0.12, 8)
+    body = np.array([[0.7 + ri * np.cos(a), ri * np.sin(a), 0.03] for ri in r for a in t])
+    handle = np.array([[x, y, 0.03] for x in np.linspace(0.84, 0.96, 13) for y in (-0.01, 0.01)])
+    pan.p_W = np.vstack([body, np.tile(body[-60:], (4, 1)), handle])  # centroid near the middle
+    far = grasp_pose([0.9, 0.0, 0.03], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
+    result = plan_pick_and_place(candidates([(far, "handle")], [0.9]), target=pan,
+                                 place_xy=[0.5, -0.3])
+    assert result.status == "unreachable"
+    assert "m lever (at most 0.12 m)" in result.candidate_reasons[0]

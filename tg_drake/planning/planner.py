@@ -97,6 +97,10 @@ class PlannerConfig:
     # score × exp(−ℓ / torsion_length), ℓ the lever about the closing axis of the object's
     # weight at its perceived centroid (`torsion_lever`): the pads resist that turn by friction
     # alone, and a hammer held at the middle of its handle turned out of them while carried.
+    max_torsion_lever: float = 0.12  # [m] a candidate whose `torsion_lever` is longer is
+    # refused: held 15 cm from its middle by the handle, a 2 kg pan turned out of the pads at
+    # 80 N every time, while its rim held (the part is then reported as not reachable, and the
+    # logic moves on to the next part).
     max_length_ratio: float = 2.0  # fingers do not close along a part's length when it is this
     # many times longer than its other extents (a knife's handle, taken end to end, slipped out).
     place_yaws: tuple = (0.0, 60.0, -60.0, 120.0, -120.0, 180.0)  # [deg] turns of the object
@@ -306,6 +310,14 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 reasons[i] = _farthest(reasons[i], (
                     f"only {depth * 1000:.0f} mm of the object reaches between the pads (at least "
                     f"{config.min_pad_depth * 1000:.0f} mm): too flat to pick up from the table"))
+                continue
+            lever = np.inf if centroid is None else torsion_lever(X_WG, centroid)
+            if centroid is not None and lever > config.max_torsion_lever:
+                costs[i] = np.inf
+                reasons[i] = _farthest(reasons[i], (
+                    f"the object's weight would turn it about the closing axis with a "
+                    f"{lever:.3f} m lever (at most {config.max_torsion_lever} m): the pads resist "
+                    "that turn by friction alone"))
                 continue
             if not counted:  # this candidate reaches the inverse kinematics
                 tried[part] += 1
