@@ -1,6 +1,6 @@
 """Speed figure of the sweep engine: `sweep_efficiency`.
 
-A small evaluation sweep — the first 16 cases of the S_REAL suite (render, perceive, kernel prior,
+A small evaluation sweep — the first 64 cases of the S_REAL suite (render, perceive, kernel prior,
 every logic method; about 0.3–2 s each) — run by the local process pool with 2 workers, against
 the same sweep with 1 worker. Each run starts a fresh pool and writes its own results file, so the
 time includes spawning the workers and compiling the theories in each, as a user's sweep does.
@@ -15,7 +15,7 @@ from pathlib import Path
 
 from tg_drake.bench import Figure, figure
 
-N_CASES = 16
+N_CASES = 64
 
 
 def _sweep_seconds(cases, workers: int) -> float:
