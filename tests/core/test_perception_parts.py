@@ -189,6 +189,6 @@ def test_a_long_part_also_gets_grasps_along_it_closing_across_it():
     shift = cfg.along_fraction * handle[0]
     np.testing.assert_allclose(np.sort(np.unique(np.round(p_grasp[:, 0], 9))),
                                [0.6 - shift, 0.6 + shift], atol=1e-12)
-    # A short or stubby box gets none.
+    # A short box, or one not twice as long as it is wide, gets none.
     assert along_pregrasps(X_WB, np.array([0.03, 0.015, 0.015]), cfg).shape == (0, 4, 4)
     assert along_pregrasps(X_WB, np.array([0.06, 0.04, 0.015]), cfg).shape == (0, 4, 4)

@@ -276,48 +276,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         if not variants:
             costs[i], reasons[i] = np.inf, "the open pads would reach under the table top"
         for X_WG in variants:
-            width = _part_width(target, part, X_WG)
-            if width > config.open_width - config.width_margin:
-                # The box overstates what lies between the fingers for a grasp across a wall
-                # (a rim grasp on a bowl): measure the perceived points there instead.
-                width = min(width, _width_between_pads(target, X_WG))
-            if width > config.open_width - config.width_margin:
-                costs[i] = np.inf
-                reasons[i] = _farthest(reasons[i], f"{part} is {width:.3f} m across the fingers; "
-                                                   f"the WSG opens {config.open_width} m")
-                continue
-            # The part may fit while the object around it does not: a can lying on its side,
-            # taken at its middle with the fingers along its 113 mm axis, is held by its end
-            # caps and stays wedged between the fingers opened to 110 mm at the release. Only
-            # an object past both pads is refused: past one (a cup's handle, a bowl's far wall
-            # in a rim grasp) the fingers still open clear of it.
-            lo, hi = _extent_along_closing(target, X_WG, config.release_band)
-            half = (config.open_width - config.release_gap) / 2
-            if -lo > half and hi > half:
-                costs[i] = np.inf
-                reasons[i] = _farthest(reasons[i], (
-                    f"the object reaches past both pads ({hi - lo:.3f} m along the closing axis "
-                    f"there; its {part} {width:.3f} m): the WSG, open to {config.open_width} m, "
-                    "could not let go"))
-                continue
-            along = _closes_along_length(target, part, X_WG, config)
-            if along:
-                costs[i], reasons[i] = np.inf, _farthest(reasons[i], along)
-                continue
-            depth = _depth_between_pads(target, X_WG, config.open_width)
-            if depth < config.min_pad_depth:
-                costs[i] = np.inf
-                reasons[i] = _farthest(reasons[i], (
-                    f"only {depth * 1000:.0f} mm of the object reaches between the pads (at least "
-                    f"{config.min_pad_depth * 1000:.0f} mm): too flat to pick up from the table"))
-                continue
-            lever = np.inf if centroid is None else torsion_lever(X_WG, centroid)
-            if centroid is not None and lever > config.max_torsion_lever:
-                costs[i] = np.inf
-                reasons[i] = _farthest(reasons[i], (
-                    f"the object's weight would turn it about the closing axis with a "
-                    f"{lever:.3f} m lever (at most {config.max_torsion_lever} m): the pads resist "
-                    "that turn by friction alone"))
+            refusal = _refusal(target, part, X_WG, centroid, config)
+            if refusal:
+                costs[i], reasons[i] = np.inf, _farthest(reasons[i], refusal)
                 continue
             if not counted:  # this candidate reaches the inverse kinematics
                 tried[part] += 1
@@ -617,6 +578,46 @@ def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray, open_width:
     if not len(p):
         p = _slab_points(target, X_WG, reach=open_width / 2)
     return float(PAD_CORNERS_G[:, 1].max() - p[:, 1].min()) if len(p) else 0.0
+
+
+def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, config
+             ) -> str:
+    """Why the geometry of the grasp X_WG on `part` rules it out before any IK ("" if it does
+    not): the part or the object does not fit the opening, the fingers would close along a long
+    part, too little of the object reaches between the pads, or the object's weight would turn it
+    in the pads. `centroid`: the object's perceived centroid (None: no points)."""
+    width = _part_width(target, part, X_WG)
+    if width > config.open_width - config.width_margin:
+        # The box overstates what lies between the fingers for a grasp across a wall (a rim
+        # grasp on a bowl): measure the perceived points there instead.
+        width = min(width, _width_between_pads(target, X_WG))
+    if width > config.open_width - config.width_margin:
+        return f"{part} is {width:.3f} m across the fingers; the WSG opens {config.open_width} m"
+    # The part may fit while the object around it does not: a can lying on its side, taken at
+    # its middle with the fingers along its 113 mm axis, is held by its end caps and stays wedged
+    # between the fingers opened to 110 mm at the release. Only an object past both pads is
+    # refused: past one (a cup's handle, a bowl's far wall in a rim grasp) the fingers still open
+    # clear of it.
+    lo, hi = _extent_along_closing(target, X_WG, config.release_band)
+    half = (config.open_width - config.release_gap) / 2
+    if -lo > half and hi > half:
+        return (f"the object reaches past both pads ({hi - lo:.3f} m along the closing axis "
+                f"there; its {part} {width:.3f} m): the WSG, open to {config.open_width} m, "
+                "could not let go")
+    along = _closes_along_length(target, part, X_WG, config)
+    if along:
+        return along
+    depth = _depth_between_pads(target, X_WG, config.open_width)
+    if depth < config.min_pad_depth:
+        return (f"only {depth * 1000:.0f} mm of the object reaches between the pads (at least "
+                f"{config.min_pad_depth * 1000:.0f} mm): too flat to pick up from the table")
+    if centroid is not None:
+        lever = torsion_lever(X_WG, centroid)
+        if lever > config.max_torsion_lever:
+            return (f"the object's weight would turn it about the closing axis with a "
+                    f"{lever:.3f} m lever (at most {config.max_torsion_lever} m): the pads resist "
+                    "that turn by friction alone")
+    return ""
 
 
 def torsion_lever(X_WG: np.ndarray, p_WC: np.ndarray) -> float:
