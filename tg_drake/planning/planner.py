@@ -529,11 +529,11 @@ def _part_width(target: ObjectDescription, part: str, X_WG: np.ndarray) -> float
 
 
 def _slab_points(target: ObjectDescription, X_WG: np.ndarray, *, reach: float,
-                 visible_only: bool = False) -> np.ndarray:
+                 visible_only: bool = False, band: float | None = None) -> np.ndarray:
     """The target's perceived points in G in the slab the open finger pads sweep: along the
-    approach over the pads' length, across their width, and within `reach` of the grasp point
-    along the closing axis (only the points the camera saw, not completed ones, with
-    `visible_only`)."""
+    approach over the pads' length, across their width (or within `band` of the grasp point
+    across them), and within `reach` of the grasp point along the closing axis (only the points
+    the camera saw, not completed ones, with `visible_only`)."""
     p_W = np.asarray(target.p_W, float)
     visible = np.asarray(target.visible, bool)
     if visible_only and len(visible) == len(p_W):
@@ -541,7 +541,7 @@ def _slab_points(target: ObjectDescription, X_WG: np.ndarray, *, reach: float,
     p_G = (p_W - X_WG[:3, 3]) @ X_WG[:3, :3]
     lo, hi = PAD_CORNERS_G[:, 1].min(), PAD_CORNERS_G[:, 1].max()
     inside = ((p_G[:, 1] >= lo) & (p_G[:, 1] <= hi)
-              & (np.abs(p_G[:, 2]) <= PAD_CORNERS_G[:, 2].max())
+              & (np.abs(p_G[:, 2]) <= (PAD_CORNERS_G[:, 2].max() if band is None else band))
               & (np.abs(p_G[:, 0]) <= reach))
     return p_G[inside]
 
@@ -559,9 +559,7 @@ def _extent_along_closing(target: ObjectDescription, X_WG: np.ndarray, band: flo
     """(lowest, highest) x_G [m] of the target's perceived points (completed ones too: the camera
     misses a far end) within the pads' length along the approach and within `band` of the grasp
     point across the pads; (0, 0) when there are none."""
-    p_G = (np.asarray(target.p_W, float) - X_WG[:3, 3]) @ X_WG[:3, :3]
-    lo, hi = PAD_CORNERS_G[:, 1].min(), PAD_CORNERS_G[:, 1].max()
-    x = p_G[(p_G[:, 1] >= lo) & (p_G[:, 1] <= hi) & (np.abs(p_G[:, 2]) <= band), 0]
+    x = _slab_points(target, X_WG, reach=np.inf, band=band)[:, 0]
     return (float(x.min()), float(x.max())) if len(x) else (0.0, 0.0)
 
 
