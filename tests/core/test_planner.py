@@ -364,6 +364,33 @@ def test_a_part_too_flat_for_the_pads_above_the_table_is_refused():
     blade = plate(0.018)
     blade.visible = blade.p_W[:, 2] <= 0.006 + 1e-9
     assert _depth_between_pads(blade, X, OPEN) == pytest.approx(0.006 - TABLE_CLEARANCE, abs=1e-9)
+    # Seen points near the grasp but none between the pads (a blade lying below the pads' tips,
+    # completion mirrored upwards): nothing the camera saw reaches between them.
+    low = plate(0.018)
+    low.visible = low.p_W[:, 2] <= 0.002 + 1e-9
+    assert _depth_between_pads(low, X, OPEN) == 0.0
+
+
+def test_a_thin_edge_pinched_in_a_side_grasp_is_refused():
+    from tg_drake.planning.planner import _overlap_across_pads, _refusal
+
+    def blade(height, z0=0.02):
+        # A vertical plate 6 cm long, 2 mm thick, `height` tall, its bottom at z0.
+        g = np.linspace(-0.03, 0.03, 31)
+        x, y, z = np.meshgrid(g, np.linspace(-0.001, 0.001, 3), np.linspace(0, height, 61))
+        o = box_object([0.75, 0.0, z0 + height / 2], [0.06, 0.002, height], parts=("middle",))
+        o.p_W = np.column_stack([0.75 + x.ravel(), y.ravel(), z0 + z.ravel()])
+        return o
+
+    config = PlannerConfig()
+    # A side grasp closing across the plate's thickness, the pads' 20 mm width vertical.
+    X = grasp_pose([0.75, 0.0, 0.03], approach_W=[1, 0, 0], closing_W=[0, 1, 0])
+    assert _overlap_across_pads(blade(0.03, 0.015), X, config.open_width) == pytest.approx(
+        0.02, abs=1e-3)  # the plate covers the pads' whole width
+    edge = blade(0.002, 0.029)
+    assert _overlap_across_pads(edge, X, config.open_width) == pytest.approx(0.002, abs=1e-9)
+    assert "thin edge" in _refusal(edge, "middle", X, None, config)
+    assert _refusal(blade(0.03, 0.015), "middle", X, None, config) == ""
 
 
 def test_place_variants_turn_the_object_about_the_vertical_through_its_centre():

@@ -93,6 +93,8 @@ class PlannerConfig:
     min_pad_depth: float = 0.01  # [m] how far along the pads (the approach) the object must
     # reach between them: a knife's 12 mm blade lying flat rises only 7 mm above the pads'
     # lowest point (TABLE_CLEARANCE) and was pressed out of the fingers.
+    min_pad_overlap: float = 0.005  # [m] how far across the pads' 20 mm width the object must
+    # span between them: a 2 mm blade pinched edge-on in a side grasp slides out of the pads.
     torsion_length: float = 0.1  # [m] within a part, candidates are tried in the order of
     # score × exp(−ℓ / torsion_length), ℓ the lever about the closing axis of the object's
     # weight at its perceived centroid (`torsion_lever`): the pads resist that turn by friction
@@ -572,10 +574,24 @@ def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray, open_width:
     flat blade about the handle's axis, which makes a 6 mm spatula blade look 16 mm tall."""
     if len(target.p_W) == 0:
         return float("inf")
-    p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=True)
-    if not len(p):
-        p = _slab_points(target, X_WG, reach=open_width / 2)
+    p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
     return float(PAD_CORNERS_G[:, 1].max() - p[:, 1].min()) if len(p) else 0.0
+
+
+def _any_visible(target: ObjectDescription) -> bool:
+    visible = np.asarray(target.visible, bool)
+    return len(visible) == len(target.p_W) and bool(visible.any())
+
+
+def _overlap_across_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float
+                         ) -> float:
+    """How far across the pads' width (z_G) the object spans between the open pads [m] (inf when
+    perception gave no points). Measured on the points the camera saw where there are any, as
+    `_depth_between_pads`."""
+    if len(target.p_W) == 0:
+        return float("inf")
+    p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
+    return float(np.ptp(p[:, 2])) if len(p) else 0.0
 
 
 def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, config
@@ -609,6 +625,11 @@ def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, c
     if depth < config.min_pad_depth:
         return (f"only {depth * 1000:.0f} mm of the object reaches between the pads (at least "
                 f"{config.min_pad_depth * 1000:.0f} mm): too flat to pick up from the table")
+    overlap = _overlap_across_pads(target, X_WG, config.open_width)
+    if overlap < config.min_pad_overlap:
+        return (f"the object spans only {overlap * 1000:.0f} mm across the pads' width between "
+                f"them (at least {config.min_pad_overlap * 1000:.0f} mm): a thin edge pinched "
+                "between the pads slides out")
     if centroid is not None:
         lever = torsion_lever(X_WG, centroid)
         if lever > config.max_torsion_lever:
