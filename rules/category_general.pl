@@ -15,5 +15,6 @@ some(X, tool) :- part(usable_area, X), part(handle, X).
 
 % Part signatures that rule a super-category out (ours).
 incompatible(X) :- kind(X, canister), part(handle, X).
+incompatible(X) :- kind(X, canister), interior_seen(X).
 incompatible(X) :- kind(X, tool), \+ part(usable_area, X).
 incompatible(X) :- kind(X, container), part(usable_area, X).

@@ -18,6 +18,7 @@ some(X, tool) :- part(usable_area, X), part(handle, X), pose(X, sideways).
 % Part signatures that rule a category out (ours; the paper's cup example needs the first and the
 % fourth: "can and pot become 0").
 incompatible(X) :- kind(X, canister), part(handle, X).
+incompatible(X) :- kind(X, canister), interior_seen(X).
 incompatible(X) :- cat(X, glass), part(handle, X).
 incompatible(X) :- cat(X, bowl), part(handle, X).
 incompatible(X) :- cat(X, pot), one_handle(X).

@@ -91,6 +91,7 @@ class ObjectDescription:
     containment: str | None = None  # "empty", "full", or None when unknown.
     is_tool: bool = False  # True when perception classified the shape as a tool.
     name: str = ""  # ground-truth instance name when known (GroundTruthPerception), else "".
+    interior_seen: float = 0.0  # probability that its inside was seen through a wide opening.
 
 
 @dataclass

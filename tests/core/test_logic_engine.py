@@ -118,6 +118,23 @@ def test_an_upside_down_pan_gets_no_grasp(specific):
     assert specific.query(upright).part.sum() == pytest.approx(1.0, abs=EXACT)
 
 
+@pytest.mark.parametrize("theory", ["specific", "general", "learned"])
+def test_an_inside_seen_through_the_top_rules_out_cans_and_bottles(theory):
+    engine = LogicEngine(TheoryConfig.named(theory))
+    tall = Observations(parts={"top": 1.0, "middle": 1.0, "bottom": 1.0}, pose={"upright": 1.0},
+                        containment={"empty": 1.0},
+                        category_prior={"can": 0.6, "bottle": 0.2, "glass": 0.15, "bowl": 0.05})
+    closed = engine.query(tall).category
+    opened = engine.query(dataclasses.replace(tall, interior_seen=1.0)).category
+    half = engine.query(dataclasses.replace(tall, interior_seen=0.5)).category
+    can, bottle, glass = (CATEGORIES.index(c) for c in ("can", "bottle", "glass"))
+    assert closed[can] > closed[glass] > 0
+    assert opened[can] == opened[bottle] == 0.0 and opened.sum() == pytest.approx(1.0)
+    assert CATEGORIES[int(np.argmax(opened))] == "glass"
+    # An uncertain sighting halves the cans' weight against the open containers'.
+    assert half[can] / half[glass] == pytest.approx(0.5 * closed[can] / closed[glass], rel=1e-6)
+
+
 def test_a_colliding_part_gets_probability_zero_and_the_others_keep_their_ratios(specific):
     base = specific.query(with_task(FIG1_CUP, "pass"))
     blocked = specific.query(dataclasses.replace(FIG1_CUP, task="pass", collisions=("middle",)))

@@ -29,6 +29,7 @@ CUP = {"parts": {"top": 0.8, "middle": 1.0, "bottom": 1.0, "handle": 1.0},
     ({"containment": "half"}, "unknown containment 'half'; allowed: empty, full"),
     ({"collisions": ["rim"]}, "field 'collisions'.*unknown part 'rim'"),
     ({"handles": 3}, "handles must be 1 or 2"),
+    ({"interior_seen": 2}, "field 'interior_seen'.*probability in \\[0, 1\\], got 2"),
     ({"colour": "red"}, "unknown field 'colour'; allowed: parts, pose"),
     ({"parts": None}, "field 'parts'"),
 ])

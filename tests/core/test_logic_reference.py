@@ -22,7 +22,8 @@ SCENES = {
     "noisy_bottle_pour_out": Observations(
         parts={"top": 0.9, "middle": 1.0, "bottom": 0.7, "handle": 0.2},
         pose={"upright": 0.6, "sideways": 0.3, "upsidedown": 0.1}, containment={"full": 0.8},
-        category_prior={"bottle": 0.5, "can": 0.2, "glass": 0.2, "cup": 0.1}, task="pourOut"),
+        category_prior={"bottle": 0.5, "can": 0.2, "glass": 0.2, "cup": 0.1}, task="pourOut",
+        interior_seen=0.7),
     "pot_two_handles_uniform_prior_collision": Observations(
         parts={"top": 1.0, "middle": 1.0, "bottom": 1.0, "handle": 0.9}, pose={"upright": 1.0},
         handles=2, task="p&pOn", collisions=("handle",)),

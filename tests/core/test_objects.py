@@ -302,3 +302,25 @@ def test_box_centre_is_half_the_height_above_the_base():
         c = box_centre(o)
         assert c[2] == pytest.approx(o.extents[2] / 2, abs=1e-4)  # extents: rounded
     assert np.linalg.norm(box_centre("bottle_02")[:2]) < 1e-3  # round: on its axis
+
+
+def test_open_top_is_a_wide_opening_seen_unless_upside_down():
+    from tg_drake.perception.ground_truth import interior_visible, open_top
+
+    OPEN = {"cup", "glass", "bowl", "pot", "pan"}
+    for obj_id, obj in load_library().items():
+        if obj.is_tool:
+            assert interior_visible(obj_id, "sideways") == 0.0
+            continue
+        assert interior_visible(obj_id, "upright") == float(obj.category in OPEN), obj_id
+        assert interior_visible(obj_id, "upsidedown") == 0.0
+    # A cylinder with a lid 4 mm down is closed; the same cylinder open at the top is not.
+    g = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    wall = np.array([[0.03 * np.cos(a), 0.03 * np.sin(a), z] for a in g
+                     for z in np.linspace(0, 0.12, 25)])
+    disk = np.array([[r * np.cos(a), r * np.sin(a)] for a in g for r in np.linspace(0, 0.03, 8)])
+    lid = np.column_stack([disk, np.full(len(disk), 0.116)])
+    bottom = np.column_stack([disk, np.full(len(disk), 0.004)])
+    labels = np.zeros(len(wall) + len(disk), int)
+    assert not open_top(np.vstack([wall, lid]), labels)
+    assert open_top(np.vstack([wall, bottom]), labels)

@@ -65,6 +65,18 @@ def test_cavity_makes_an_open_cup_surely_upright():
     assert o.pose_likelihood["upright"] > 0.9
 
 
+@pytest.mark.parametrize("view", range(len(EYES)))
+def test_the_inside_is_seen_through_an_open_top_only(view):
+    # Open containers standing up show their inside; a closed can, a bottle's narrow neck, an
+    # upside-down glass and a tool do not.
+    seen = {name: describe(mesh, EYES[view]).interior_seen for name, mesh in (
+        ("cup", SHAPES["cup"][0]), ("glass", S.glass(0.028, 0.038, 0.12)),
+        ("can", S.cylinder(0.033, 0.12)), ("bottle", SHAPES["bottle"][0]),
+        ("glass_upside_down", SHAPES["glass_upside_down"][0]), ("hammer", SHAPES["hammer"][0]))}
+    assert seen["cup"] > 0.9 and seen["glass"] > 0.9
+    assert seen["can"] == seen["bottle"] == seen["glass_upside_down"] == seen["hammer"] == 0.0
+
+
 def test_top_middle_bottom_follow_the_axis_and_the_handle_is_outside():
     o = describe(SHAPES["mug"][0], EYES[1], yaw=1.0)
     z = o.p_W[:, 2]

@@ -23,8 +23,8 @@ import numpy as np
 from tg_drake.errors import PerceptionError, RuleError, TgDrakeError
 from tg_drake.types import CATEGORIES, TASKS
 
-# Logic methods (the paper's columns and the two ablations): name → (category/task theory,
-# pre-grasp theory, prior). Theories as (category model, grasp model, exclusive); the pre-grasp
+# Logic methods (the paper's columns, the paper's two ablations and ours): name → (category/task
+# theory, pre-grasp theory, prior[, "no_interior"]). Theories as (category model, grasp model, exclusive); the pre-grasp
 # columns keep the specific category model, as the paper's Table "pre-grasp" does.
 METHODS = {
     "plm_uniform": (("specific", "specific", True), ("specific", "specific", True), "uniform"),
@@ -35,6 +35,9 @@ METHODS = {
     "plm_top": (("specific", "specific", True), ("specific", "specific", True), "top"),
     "plm_nonexclusive": (("specific", "specific", False), ("specific", "specific", False),
                          "manifolds"),
+    # PLM on the paper's observations only: without `interior_seen` (ours).
+    "plm_paper_observations": (("specific", "specific", True), ("specific", "specific", True),
+                               "manifolds", "no_interior"),
 }
 PRIOR_FLOOR = 0.02  # the pipeline's (PipelineConfig.prior_floor): a prior that misses the true
 # category cannot make perceived evidence impossible.
@@ -75,14 +78,16 @@ def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS,
         return tuple(theory if m == "specific" else m for m in models[:2]) + models[2:]
 
     out = {}
-    for name, (cat_theory, grasp_theory, prior_kind) in methods.items():
+    for name, (cat_theory, grasp_theory, prior_kind, *flags) in methods.items():
         cat_theory, grasp_theory = variant(cat_theory), variant(grasp_theory)
         prior = _prior(prior_kind, priors)
+        interior = 0.0 if "no_interior" in flags else observations.interior_seen
 
         def obs(task=None):
             return Observations(parts=observations.parts, pose=observations.pose,
                                 containment=observations.containment, category_prior=prior,
-                                task=task, handles=observations.handles)
+                                task=task, handles=observations.handles,
+                                interior_seen=interior)
 
         try:
             answer = _engine(*cat_theory).query(obs())
@@ -116,15 +121,17 @@ def run_synthetic(case) -> dict:
     from tg_drake.kernels.library import sample_object
     from tg_drake.logic.observations import Observations, handle_count
     from tg_drake.objects import get_object, mesh
+    from tg_drake.perception.ground_truth import interior_visible
 
     placement = case.target_placement
     obj = get_object(placement.id)
     vertices, _, labels = mesh(obj)
     handles = handle_count(vertices, labels) if "handle" in obj.parts else 1
-    observations = Observations(parts={p: 1.0 for p in obj.parts}, pose={placement.pose: 1.0},
-                                containment={placement.containment: 1.0}, handles=handles)
     cloud = sample_object(obj, spacing=load_database().spacing,
                           rng=np.random.default_rng(_seed(case.key, case.seed)))
+    observations = Observations(parts={p: 1.0 for p in obj.parts}, pose={placement.pose: 1.0},
+                                containment={placement.containment: 1.0}, handles=handles,
+                                interior_seen=interior_visible(obj.id, placement.pose))
     priors = kernel_priors(cloud.points, cloud.normals, cloud.labels, object_id=obj.id,
                            t=case.kernel_T, clouds="ground_truth")
     return {**case.meta(), "priors": priors,
@@ -180,7 +187,8 @@ def setting_observations(description, setting: str, *, true_pose: str, containme
     else:
         parts, pose = detected, dict(description.pose_likelihood)
     return Observations(parts=parts, pose=pose, containment={containment: 1.0},
-                        handles=count_handles(description))
+                        handles=count_handles(description),
+                        interior_seen=description.interior_seen)
 
 
 def run_perceived(case) -> list[dict]:

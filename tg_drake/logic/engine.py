@@ -145,7 +145,8 @@ def _inconsistent(obs: Observations, config: TheoryConfig) -> RuleError:
     return RuleError(
         "the observations have probability 0 under the theory "
         f"({config.category} category model): no category of the prior ({prior}) is "
-        f"compatible with the observed parts ({parts}, handles {obs.handles})",
+        f"compatible with the observed parts ({parts}, handles {obs.handles}"
+        + (f", inside seen {obs.interior_seen:g}" if obs.interior_seen > 0 else "") + ")",
         file=obs.source, field="category_prior")
 
 
@@ -314,6 +315,9 @@ class CompiledTheory:
         reasons.append((f"category prior: {prior}", [rows[("prior", c)] for c in CATEGORIES]))
         if obs.handles == 2 and obs.parts.get("handle", 0.0) > 0:
             reasons.append(("observed two handles", [rows[("handles", "pair")]]))
+        if obs.interior_seen > 0:
+            reasons.append((f"saw the inside through an open top with P={obs.interior_seen:g}",
+                            [rows[("interior", "seen")]]))
         return reasons
 
     def explain(self, obs: Observations, params: np.ndarray,

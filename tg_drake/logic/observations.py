@@ -2,7 +2,9 @@
 
 `Observations` holds what perception, the kernel prior, the user and the planner say about the
 object under query: probabilistic parts, the pose likelihood, containment, the category prior (an
-annotated disjunction, or uniform), the given task or a task prior, and collision(Part) evidence.
+annotated disjunction, or uniform), the given task or a task prior, collision(Part) evidence, the
+handle count, and whether the object's inside was seen through a wide opening (`interior_seen`,
+ours: the paper's parts cannot tell a glass from a can of the same shape; an open top can).
 It is validated on construction; bad input raises `RuleError` naming the field and the allowed
 values.
 
@@ -61,6 +63,8 @@ class Observations:
     # TASKS entry → probability when the task is inferred (sum ≤ 1, > 0); None: uniform 1/7.
     collisions: tuple[str, ...] = ()  # parts the gripper cannot reach: collision(Part) evidence.
     handles: int = 1  # handles seen when the handle part is there: 1, or 2 (a pot's pair).
+    interior_seen: float = 0.0  # probability that the object's inside was seen through a wide
+    # opening (0: not seen, or it could not be: upside down, facing away). Beyond the paper.
     source: str | None = None  # the file these came from, for error messages.
 
     def __post_init__(self):
@@ -99,6 +103,12 @@ class Observations:
         if self.handles not in (1, 2):
             raise RuleError(f"handles must be 1 or 2, got {self.handles!r}", file=self.source,
                             field="handles")
+        p = self.interior_seen
+        if isinstance(p, bool) or not isinstance(p, int | float) or not math.isfinite(p) \
+                or not 0.0 <= p <= 1.0:
+            raise RuleError(f"interior_seen must be a probability in [0, 1], got {p!r}",
+                            file=self.source, field="interior_seen")
+        self.interior_seen = float(p)
 
     # ---- as weights of the compiled schema -------------------------------------------------
 
@@ -113,6 +123,7 @@ class Observations:
             stick_breaking(self.task_vector()),
             np.array([float(p in self.collisions) for p in PART_LABELS]),
             np.array([float(self.handles == 2)]),
+            np.array([self.interior_seen]),
         ])
 
     def containment_vector(self) -> np.ndarray:
@@ -140,7 +151,7 @@ class Observations:
         if not isinstance(data, dict):
             raise RuleError("an observations file holds a mapping of fields", file=source)
         allowed = ("parts", "pose", "containment", "category_prior", "task", "task_prior",
-                   "collisions", "handles")
+                   "collisions", "handles", "interior_seen")
         for key in data:
             if key not in allowed:
                 raise unknown_name("field", key, allowed, error=RuleError, file=source,
@@ -175,7 +186,8 @@ class Observations:
                    category_prior=data.get("category_prior"), task=task,
                    task_prior=data.get("task_prior"),
                    collisions=tuple(collisions) if not isinstance(collisions, str)
-                   else (collisions,), handles=handles, source=source)
+                   else (collisions,), handles=handles,
+                   interior_seen=data.get("interior_seen", 0.0), source=source)
 
     @classmethod
     def from_file(cls, path: str | Path) -> Observations:
@@ -216,7 +228,8 @@ class Observations:
         return cls(parts=dict(obj.part_probabilities), pose=dict(obj.pose_likelihood),
                    containment=None if obj.containment is None else {obj.containment: 1.0},
                    category_prior=category_prior, task=task or None,
-                   collisions=tuple(collisions), handles=count_handles(obj))
+                   collisions=tuple(collisions), handles=count_handles(obj),
+                   interior_seen=float(getattr(obj, "interior_seen", 0.0)))
 
 
 def count_handles(obj: ObjectDescription) -> int:
@@ -306,6 +319,7 @@ SCHEMA_PARAMETERS: tuple[tuple[str, str], ...] = (
     + tuple(("task", t) for t in TASKS)
     + tuple(("collision", p) for p in PART_LABELS)
     + (("handles", "pair"),)
+    + (("interior", "seen"),)
 )
 
 # The placeholder weight of schema facts while grounding: anything strictly inside (0, 1) keeps a
@@ -340,6 +354,9 @@ def observation_schema() -> tuple[list[Term], dict[Term, int]]:
     fact = Term("handle_pair", o)
     clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
     rows[fact] = index[("handles", "pair")]
+    fact = Term("interior_seen", o)
+    clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
+    rows[fact] = index[("interior", "seen")]
     return clauses, rows
 
 
@@ -368,6 +385,7 @@ def observation_clauses(obs: Observations) -> list[Term]:
         clauses.append(Term("collision", Term(part)))
     if obs.handles == 2:
         clauses.append(Term("handle_pair", o))
+    fact(Term("interior_seen", o), obs.interior_seen)
     # An observation predicate with no clause in this scene (no collision, no pose, ...) is
     # defined as failing, so that ProbLog does not reject the theory's calls to it.
     defined = {_head(c).signature for c in clauses}
@@ -389,7 +407,7 @@ def _head(clause: Term) -> Term:
 def _schema_heads() -> list[Term]:
     o = _o()
     heads = [Term("part", Term(PART_LABELS[0]), o), Term("collision", Term(PART_LABELS[0])),
-             Term("handle_pair", o)]
+             Term("handle_pair", o), Term("interior_seen", o)]
     for _, group_heads, _ in _ad_groups():
         heads.extend(group_heads)
     return heads

@@ -61,6 +61,8 @@ class PoseConfig:
     cavity_depth_fraction: float = 0.12  # ... or this share of the object height if larger.
     min_cavity_share: float = 0.25  # share of far-side points inside the rim that are deep.
     min_cavity_points: int = 6  # at least this many deep points make a cavity.
+    min_interior_share: float = 0.12  # the `interior_seen` observation: this share of the
+    # visible body points faces into the object (pose.interior_seen).
     neck_ratio: float = 0.6  # top radius below this share of the base radius is a neck ...
     neck_body_ratio: float = 0.95  # ... over a body this wide at mid-height (else a taper).
     taper_ratio: float = 0.95  # top radius below this share of the base radius is a taper ...

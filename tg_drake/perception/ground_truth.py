@@ -9,6 +9,8 @@ pipeline's perception never reads ground truth.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from tg_drake.errors import PerceptionError
@@ -37,6 +39,47 @@ def pose_from_transform(X_WO: np.ndarray, X_WT: np.ndarray, is_tool: bool) -> st
     c = X_WO[:3, 2] @ X_WT[:3, 2]
     return "upright" if c > UPRIGHT_COSINE else ("upsidedown" if c < -UPRIGHT_COSINE
                                                  else "sideways")
+
+
+# A wide opening: the surface within half the body's radius of its axis lies at least this share
+# of the body's height below its top. Sampled library meshes: cans 0.03–0.04 (a lid 4 mm down),
+# bottles 0 (the neck), every glass, cup, bowl, pot and pan 0.88–0.98.
+OPEN_TOP_DEPTH = 0.25
+
+
+def open_top(p_O: np.ndarray, labels: np.ndarray) -> bool:
+    """Whether a container's surface points (its library frame: z along the symmetry axis
+    towards the top) show a wide open top: the surface near the axis lies deep below the rim."""
+    body = np.asarray(labels) != part_index("handle")
+    q = np.asarray(p_O, float)[body]
+    if len(q) == 0:
+        return False
+    rho = np.linalg.norm(q[:, :2], axis=1)
+    central = rho < 0.5 * rho.max()
+    top, height = q[:, 2].max(), np.ptp(q[:, 2])
+    if not central.any() or height <= 0:
+        return False
+    return bool(top - q[central, 2].max() >= OPEN_TOP_DEPTH * height)
+
+
+@functools.lru_cache(maxsize=None)
+def library_open_top(obj_id: str) -> bool:
+    """`open_top` of a library object, on a fixed sampling of 4,000 surface points."""
+    from tg_drake.objects import get_object, sample_surface
+
+    p_O, _, labels = sample_surface(get_object(obj_id), n=4000, rng=np.random.default_rng(0))
+    return open_top(p_O, labels)
+
+
+def interior_visible(obj_id: str, pose: str) -> float:
+    """The perfect `interior_seen` observation of a library object in a pose: 1 for an open
+    container unless it stands upside down (its opening on the table, out of any camera's sight),
+    else 0 (tools too)."""
+    from tg_drake.objects import get_object
+
+    if get_object(obj_id).is_tool or pose == "upsidedown":
+        return 0.0
+    return float(library_open_top(obj_id))
 
 
 def describe_library_object(obj_id: str, X_WO: np.ndarray, X_WT: np.ndarray, *,
@@ -93,4 +136,5 @@ def describe_library_object(obj_id: str, X_WO: np.ndarray, X_WT: np.ndarray, *,
         pose_likelihood={p: float(p == pose) for p in POSES},
         part_probabilities={name: 1.0 for name in boxes}, part_boxes=boxes,
         pregrasp_X_WG=X_WG, pregrasp_parts=grasp_parts, containment=containment,
-        is_tool=obj.is_tool, name=obj_id)
+        is_tool=obj.is_tool, name=obj_id,
+        interior_seen=interior_visible(obj_id, pose))

@@ -23,7 +23,7 @@ from tg_drake.perception.geometry import (
     voxel_average,
 )
 from tg_drake.perception.parts import segment_parts
-from tg_drake.perception.pose import estimate_pose, tool_pose
+from tg_drake.perception.pose import estimate_pose, interior_seen, tool_pose
 from tg_drake.perception.pregrasp import part_pregrasps
 from tg_drake.perception.segmentation import segment_depth
 from tg_drake.types import ObjectDescription, PartBox, SceneDescription, part_index
@@ -79,7 +79,8 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
         p_W=transform(X_WT, c.p_T), n_W=rotate(X_WT, c.n_T), labels=parts.labels,
         visible=c.visible, X_WO=X_WO, extents=parts.extents, pose=pose.pose,
         pose_likelihood=pose.likelihood, part_probabilities=parts.probabilities, part_boxes=boxes,
-        pregrasp_X_WG=X_WG, pregrasp_parts=grasp_parts, containment=None, is_tool=parts.is_tool)
+        pregrasp_X_WG=X_WG, pregrasp_parts=grasp_parts, containment=None, is_tool=parts.is_tool,
+        interior_seen=interior_seen(pose, parts.is_tool, cfg.pose))
 
 
 def describe_cloud(p_W: np.ndarray, X_WT: np.ndarray, p_WC: np.ndarray,
