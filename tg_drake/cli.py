@@ -44,6 +44,16 @@ def main(argv: list[str] | None = None) -> int:
     except TgDrakeError as e:
         print(f"tg-drake {args.command}: error: {e}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # The reader went away (`tg-drake query x.yaml | head`): stop quietly, as Unix tools do,
+        # and keep Python from reporting the closed pipe again when it flushes at exit.
+        import os
+
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):  # stdout is not a file (a test's capture)
+            pass
+        return 141  # 128 + SIGPIPE, the shell's status for a command a pipe cut short
 
 
 if __name__ == "__main__":

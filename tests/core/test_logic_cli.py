@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import io
 import json
+import sys
 
 import pytest
 
@@ -55,3 +57,14 @@ def test_bench_figure_is_registered():
 
     module, function = FIGURES["logic_scene_ms"].split(":")
     assert callable(getattr(importlib.import_module(module), function))
+
+
+
+def test_a_reader_that_goes_away_stops_the_command_quietly(monkeypatch):
+    # `tg-drake query … | head -1`: writing to the closed pipe raises BrokenPipeError.
+    class ClosedPipe(io.StringIO):
+        def write(self, text):
+            raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(sys, "stdout", ClosedPipe())
+    assert main(["query", str(EXAMPLES / "glass_seen_inside.yaml")]) == 141
