@@ -155,7 +155,7 @@ def test_unreachable_place_is_not_a_collision_of_the_part():
     assert r.unreachable_parts == ()  # the top can be picked: no collision(top) evidence
     assert r.part_reachable == {"top": True}
     assert r.candidate_reasons[0].startswith("pre-place pose unreachable")
-    assert "picked but not placed" in r.reason
+    assert "picked but not placed at (1.600, 0.000) m: pre-place pose unreachable" in r.reason
 
 
 def test_zero_scores_are_ruled_out_not_unreachable():

@@ -333,7 +333,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         else:
             place_failures = [r for r in examined if r.startswith(PLACE_FAILURES)]
             reason = ("the object can be picked but not placed at "
-                      f"{tuple(np.round(place_xy, 3))}: " + (place_failures or [first])[0])
+                      f"({place_xy[0]:.3f}, {place_xy[1]:.3f}) m: "
+                      + (place_failures or [first])[0])
         return PlanResult("unreachable", None, costs, tuple(reasons), part_reachable,
                           unreachable, reason, elapsed)
     return PlanResult("planned", plan, costs, tuple(reasons), part_reachable, unreachable, "",
