@@ -495,3 +495,32 @@ def test_a_grasp_far_from_the_weight_across_the_lever_is_refused():
                                  place_xy=[0.5, -0.3])
     assert result.status == "unreachable"
     assert "m lever (at most 0.12 m)" in result.candidate_reasons[0]
+
+
+def test_a_step_under_the_pads_is_refused():
+    from tg_drake.planning.planner import _contact_share, _refusal
+
+    config = PlannerConfig()
+    # A top-down grasp closing along y over a horizontal 6 mm rod along x (the pads' width),
+    # 20 mm above the table; with a 20 mm wide block where one pad edge lands, a step.
+    X = grasp_pose([0.75, 0.0, 0.02], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
+
+    def rod(block: bool):
+        g = np.linspace(-0.03, 0.03, 61)
+        a = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+        x, t = np.meshgrid(g, a)
+        p = np.column_stack([0.75 + x.ravel(), 0.003 * np.cos(t.ravel()),
+                             0.02 + 0.003 * np.sin(t.ravel())])
+        if block:  # x from 0.75 − 0.012 back: y ±10 mm
+            b = np.linspace(-0.01, 0.01, 21)
+            bx, by, bz = np.meshgrid(np.linspace(0.72, 0.742, 12), b, np.linspace(0.01, 0.03, 11))
+            p = np.vstack([p, np.column_stack([bx.ravel(), by.ravel(), bz.ravel()])])
+        o = box_object([0.75, 0.0, 0.02], [0.06, 0.006, 0.006], parts=("middle",))
+        o.p_W = p
+        return o
+
+    assert _contact_share(rod(False), X, config.open_width) == 1.0
+    stepped = rod(True)
+    assert _contact_share(stepped, X, config.open_width) == pytest.approx(0.25)
+    assert "step or taper" in _refusal(stepped, "middle", X, None, config)
+    assert _refusal(rod(False), "middle", X, None, config) == ""

@@ -95,6 +95,10 @@ class PlannerConfig:
     # lowest point (TABLE_CLEARANCE) and was pressed out of the fingers.
     min_pad_overlap: float = 0.005  # [m] how far across the pads' 20 mm width the object must
     # span between them: a 2 mm blade pinched edge-on in a side grasp slides out of the pads.
+    min_contact_share: float = 0.5  # the pads must touch the object's widest section over at
+    # least this share of the bands (PAD_BANDS across their width) the object fills between them:
+    # a pad edge landing on a screwdriver's 17 mm handle end while the rest of the pad lies over
+    # its 6 mm shaft touched the handle end only, and squeezed it out.
     torsion_length: float = 0.1  # [m] within a part, candidates are tried in the order of
     # score × exp(−ℓ / torsion_length), ℓ the lever about the closing axis of the object's
     # weight at its perceived centroid (`torsion_lever`): the pads resist that turn by friction
@@ -595,6 +599,27 @@ def _overlap_across_pads(target: ObjectDescription, X_WG: np.ndarray, open_width
     return float(np.ptp(p[:, 2])) if len(p) else 0.0
 
 
+PAD_BANDS = 4  # bands across the pads' 20 mm width for `_contact_share`
+CONTACT_TOLERANCE = 0.004  # [m] a band this close to the widest one touches too (a voxel)
+
+
+def _contact_share(target: ObjectDescription, X_WG: np.ndarray, open_width: float) -> float:
+    """Share of the bands across the pads' width that the object fills between the open pads
+    in which it is about as wide along the closing axis as its widest band (within
+    CONTACT_TOLERANCE): where the closing pads touch it first (1 when perception gave no points).
+    Measured on the seen points where there are any, as `_depth_between_pads`."""
+    if len(target.p_W) == 0:
+        return 1.0
+    p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
+    half = PAD_CORNERS_G[:, 2].max()
+    band = np.clip(((p[:, 2] + half) / (2 * half) * PAD_BANDS).astype(int), 0, PAD_BANDS - 1)
+    widths = np.array([np.ptp(p[band == k, 0]) for k in range(PAD_BANDS)
+                       if np.count_nonzero(band == k) >= 2])
+    if len(widths) == 0:
+        return 1.0
+    return float(np.mean(widths >= widths.max() - CONTACT_TOLERANCE))
+
+
 def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, config
              ) -> str:
     """Why the geometry of the grasp X_WG on `part` rules it out before any IK ("" if it does
@@ -631,6 +656,11 @@ def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, c
         return (f"the object spans only {overlap * 1000:.0f} mm across the pads' width between "
                 f"them (at least {config.min_pad_overlap * 1000:.0f} mm): a thin edge pinched "
                 "between the pads slides out")
+    share = _contact_share(target, X_WG, config.open_width)
+    if share < config.min_contact_share:
+        return (f"the pads would touch the object's widest section over only {share:.0%} of "
+                f"the width the object fills between them (at least "
+                f"{config.min_contact_share:.0%}): a step or taper under the pads squeezes out")
     if centroid is not None:
         lever = torsion_lever(X_WG, centroid)
         if lever > config.max_torsion_lever:
