@@ -520,6 +520,12 @@ def test_a_step_under_the_pads_is_refused():
         return o
 
     assert _contact_share(rod(False), X, config.open_width) == 1.0
+    # A handle running past one pad in one band (a cup's): the pad goes beside it there.
+    handled = rod(False)
+    h = np.linspace(0.0, 0.06, 31)
+    handled.p_W = np.vstack([handled.p_W, np.column_stack([np.full(31, 0.758), h,
+                                                           np.full(31, 0.02)])])
+    assert _contact_share(handled, X, config.open_width) == 1.0
     stepped = rod(True)
     assert _contact_share(stepped, X, config.open_width) == pytest.approx(0.25)
     assert "step or taper" in _refusal(stepped, "middle", X, None, config)

@@ -605,16 +605,21 @@ CONTACT_TOLERANCE = 0.004  # [m] a band this close to the widest one touches too
 
 def _contact_share(target: ObjectDescription, X_WG: np.ndarray, open_width: float) -> float:
     """Share of the bands across the pads' width that the object fills between the open pads
-    in which it is about as wide along the closing axis as its widest band (within
-    CONTACT_TOLERANCE): where the closing pads touch it first (1 when perception gave no points).
+    (and does not run past them) in which it is about as wide along the closing axis as its
+    widest band (within CONTACT_TOLERANCE): where the closing pads touch it first (1 when
+    perception gave no points or no band is left).
     Measured on the seen points where there are any, as `_depth_between_pads`."""
     if len(target.p_W) == 0:
         return 1.0
     p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
     half = PAD_CORNERS_G[:, 2].max()
     band = np.clip(((p[:, 2] + half) / (2 * half) * PAD_BANDS).astype(int), 0, PAD_BANDS - 1)
+    # A band where the object reaches out to a pad's inner face runs past that pad (a cup's
+    # handle): the pad goes beside it there, and it says nothing about where the pads touch.
+    past = open_width / 2 - CONTACT_TOLERANCE
     widths = np.array([np.ptp(p[band == k, 0]) for k in range(PAD_BANDS)
-                       if np.count_nonzero(band == k) >= 2])
+                       if np.count_nonzero(band == k) >= 2
+                       and np.abs(p[band == k, 0]).max() < past])
     if len(widths) == 0:
         return 1.0
     return float(np.mean(widths >= widths.max() - CONTACT_TOLERANCE))
