@@ -393,6 +393,39 @@ def test_a_thin_edge_pinched_in_a_side_grasp_is_refused():
     assert _refusal(blade(0.03, 0.015), "middle", X, None, config) == ""
 
 
+def test_a_tool_pressed_only_above_its_widest_section_is_refused():
+    from tg_drake.planning.planner import _pad_area_below_middle, _refusal, clear_of_table
+
+    # A handle lying on the table along x: 10 cm long, 20 mm wide, 16 mm tall (knife_03's as
+    # perceived), its top and its sides down to 4 mm seen.
+    g = np.linspace(0.70, 0.80, 51)
+    top = np.stack(np.meshgrid(g, np.linspace(-0.01, 0.01, 11), [0.016]), -1).reshape(-1, 3)
+    sides = np.stack(np.meshgrid(g, [-0.01, 0.01], np.linspace(0.004, 0.016, 7)), -1).reshape(-1, 3)
+    handle = box_object([0.75, 0.0, 0.008], [0.10, 0.02, 0.016], parts=("handle",))
+    handle.p_W = np.concatenate([top, sides])
+    handle.visible = np.ones(len(handle.p_W), bool)
+    handle.is_tool = True
+    config = PlannerConfig()
+    OPEN = config.open_width
+    # Straight down across it, the pads' tips 4 mm above the table: their faces cover its lower
+    # half (4 to 8 mm) over their 20 mm width.
+    down = clear_of_table(grasp_pose([0.75, 0.0, 0.0], approach_W=[0, 0, -1],
+                                     closing_W=[0, 1, 0]), 0.0)
+    assert _pad_area_below_middle(handle, down, OPEN, 0.0) == pytest.approx(80e-6, rel=0.05)
+    assert _refusal(handle, "handle", down, None, config) == ""
+    # End-on along it, the approach tilted 35° down to clear the table: only the corner at the
+    # pads' tips reaches below its middle (a triangle of about 4² / (2 sin 35° cos 35°) mm²).
+    s, c = np.sin(np.deg2rad(35.0)), np.cos(np.deg2rad(35.0))
+    end_on = clear_of_table(grasp_pose([0.73, 0.0, 0.008], approach_W=[c, 0, -s],
+                                       closing_W=[0, 1, 0]), 0.0)
+    assert _pad_area_below_middle(handle, end_on, OPEN, 0.0) == pytest.approx(17e-6, rel=0.15)
+    assert "lower half" in _refusal(handle, "handle", end_on, None, config)
+    # The rule is the tools': a container's wall or handle is not rounded about a middle height
+    # (the other checks pass this grasp).
+    handle.is_tool = False
+    assert _refusal(handle, "handle", end_on, None, config) == ""
+
+
 def test_place_variants_turn_the_object_about_the_vertical_through_its_centre():
     from tg_drake.planning.planner import _place_variants
 

@@ -99,6 +99,14 @@ class PlannerConfig:
     # least this share of the bands (PAD_BANDS across their width) the object fills between them:
     # a pad edge landing on a screwdriver's 17 mm handle end while the rest of the pad lies over
     # its 6 mm shaft touched the handle end only, and squeezed it out.
+    min_tool_grip_area: float = 25e-6  # [m²] how much of a pad's face must lie over the lower
+    # half of a tool lying on the table (`_pad_area_below_middle`): a handle is rounded above its
+    # widest section, and pads pressing only there squeeze it down and ride up over it. Knife_03's
+    # 16 mm handle taken end-on, the approach tilted 35° down to clear the table, had 18 mm² there
+    # and rolled out of the pads at the squeeze; taken straight down across it, 80 mm², it held
+    # (with the wrist tilted 15°, 28 mm², it held too). The rule also refuses the tilted side
+    # grasps on knife blades and screwdriver shafts that slipped or closed on air in S_GRASP (five
+    # of those cases were then placed by their handles: placed 112 -> 117 of 132).
     torsion_length: float = 0.1  # [m] within a part, candidates are tried in the order of
     # score × exp(−ℓ / torsion_length), ℓ the lever about the closing axis of the object's
     # weight at its perceived centroid (`torsion_lever`): the pads resist that turn by friction
@@ -282,7 +290,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         if not variants:
             costs[i], reasons[i] = np.inf, "the open pads would reach under the table top"
         for X_WG in variants:
-            refusal = _refusal(target, part, X_WG, centroid, config)
+            refusal = _refusal(target, part, X_WG, centroid, config, table_z)
             if refusal:
                 costs[i], reasons[i] = np.inf, _farthest(reasons[i], refusal)
                 continue
@@ -625,12 +633,43 @@ def _contact_share(target: ObjectDescription, X_WG: np.ndarray, open_width: floa
     return float(np.mean(widths >= widths.max() - CONTACT_TOLERANCE))
 
 
-def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, config
-             ) -> str:
+def _pad_area_below_middle(target: ObjectDescription, X_WG: np.ndarray, open_width: float,
+                           table_z: float, cell: float = 0.001) -> float:
+    """Area [m²] of a pad's face that lies over the lower half of the object lying between the
+    pads: seen along the closing axis, the face's part that is above the table and below half the
+    height of the object's top there (its widest section, for a rounded handle), and within
+    `cell` × 2.5 of a perceived point across the face. Measured on the points the camera saw where
+    there are any (as `_depth_between_pads`); inf when perception gave no points or the pads'
+    faces do not stand upright enough for a height to mean anything (a closing axis within 30° of
+    vertical)."""
+    if len(target.p_W) == 0:
+        return float("inf")
+    up = X_WG[2, 1:3]  # the world's vertical in the faces' (y_G, z_G) coordinates
+    if np.linalg.norm(up) < np.cos(np.deg2rad(30.0)):
+        return float("inf")
+    p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
+    if not len(p):
+        return 0.0
+    across = np.array([-up[1], up[0]]) / np.linalg.norm(up)  # horizontal, in the faces' plane
+    y = np.arange(PAD_CORNERS_G[:, 1].min() + cell / 2, PAD_CORNERS_G[:, 1].max(), cell)
+    z = np.arange(PAD_CORNERS_G[:, 2].min() + cell / 2, PAD_CORNERS_G[:, 2].max(), cell)
+    face = np.stack(np.meshgrid(y, z), axis=-1).reshape(-1, 2)  # cell centres (y_G, z_G)
+    height = X_WG[2, 3] + face @ up  # their world heights
+    top = X_WG[2, 3] + p[:, 1:3] @ up  # the points' world heights
+    near = np.abs((face @ across)[:, None] - (p[:, 1:3] @ across)[None, :]) <= 2.5 * cell
+    top_there = np.where(near, top[None, :], -np.inf).max(axis=1)
+    below = (height >= table_z) & (height <= table_z + 0.5 * (top_there - table_z))
+    return float(below.sum() * cell ** 2)
+
+
+def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, config,
+             table_z: float = 0.0) -> str:
     """Why the geometry of the grasp X_WG on `part` rules it out before any IK ("" if it does
     not): the part or the object does not fit the opening, the fingers would close along a long
-    part, too little of the object reaches between the pads, or the object's weight would turn it
-    in the pads. `centroid`: the object's perceived centroid (None: no points)."""
+    part, too little of the object reaches between the pads, the pads would touch it first in
+    only part of the width it fills or press only on the upper half of a tool lying on the table
+    (its top at height `table_z`), or the object's weight would turn it in the pads. `centroid`:
+    the object's perceived centroid (None: no points)."""
     width = _part_width(target, part, X_WG)
     if width > config.open_width - config.width_margin:
         # The box overstates what lies between the fingers for a grasp across a wall (a rim
@@ -666,6 +705,12 @@ def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, c
         return (f"the pads would touch the object's widest section over only {share:.0%} of "
                 f"the width the object fills between them (at least "
                 f"{config.min_contact_share:.0%}): a step or taper under the pads squeezes out")
+    if target.is_tool:
+        area = _pad_area_below_middle(target, X_WG, config.open_width, table_z)
+        if area < config.min_tool_grip_area:
+            return (f"the pads would press on only {area * 1e6:.0f} mm² of the tool's lower half "
+                    f"(at least {config.min_tool_grip_area * 1e6:.0f} mm²): pressed above its "
+                    "widest section, it is squeezed out from between them")
     if centroid is not None:
         lever = torsion_lever(X_WG, centroid)
         if lever > config.max_torsion_lever:
