@@ -359,7 +359,8 @@ def test_a_part_too_flat_for_the_pads_above_the_table_is_refused():
     for thickness in (0.012, 0.03):
         assert _depth_between_pads(plate(thickness), X, OPEN) == pytest.approx(
             thickness - TABLE_CLEARANCE, abs=1e-9)
-    assert _depth_between_pads(plate(0.012), X, OPEN) < PlannerConfig().min_pad_depth
+    assert _depth_between_pads(plate(0.01), X, OPEN) < PlannerConfig().min_pad_depth
+    assert _depth_between_pads(plate(0.012), X, OPEN) > PlannerConfig().min_pad_depth
     # Completion mirrored a 6 mm blade up to 18 mm: the points the camera saw decide.
     blade = plate(0.018)
     blade.visible = blade.p_W[:, 2] <= 0.006 + 1e-9
@@ -563,3 +564,26 @@ def test_a_step_under_the_pads_is_refused():
     assert _contact_share(stepped, X, config.open_width) == pytest.approx(0.25)
     assert "step or taper" in _refusal(stepped, "middle", X, None, config)
     assert _refusal(rod(False), "middle", X, None, config) == ""
+
+
+def test_a_thin_tool_shaft_is_refused():
+    from tg_drake.planning.planner import _refusal, clear_of_table
+
+    def bar(width):
+        # A tool's bar along x on the table, `width` across, 16 mm tall, its top and sides seen.
+        g = np.linspace(0.70, 0.80, 51)
+        top = np.stack(np.meshgrid(g, np.linspace(-width / 2, width / 2, 5), [0.016]),
+                       -1).reshape(-1, 3)
+        sides = np.stack(np.meshgrid(g, [-width / 2, width / 2], np.linspace(0.0, 0.016, 9)),
+                         -1).reshape(-1, 3)
+        o = box_object([0.75, 0.0, 0.008], [0.10, width, 0.016], parts=("handle",))
+        o.p_W = np.concatenate([top, sides])
+        o.visible = np.ones(len(o.p_W), bool)
+        o.is_tool = True
+        return o
+
+    config = PlannerConfig()
+    down = clear_of_table(grasp_pose([0.75, 0.0, 0.0], approach_W=[0, 0, -1],
+                                     closing_W=[0, 1, 0]), 0.0)
+    assert "thin shaft" in _refusal(bar(0.006), "handle", down, None, config)
+    assert _refusal(bar(0.012), "handle", down, None, config) == ""

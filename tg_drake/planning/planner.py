@@ -90,9 +90,11 @@ class PlannerConfig:
         (0.0, 0.3, 0.0, -1.6, 0.0, -1.0, 0.0),  # wrist flipped
         (0.0, 0.2, 0.0, -1.0, 0.0, 1.6, 0.0),  # from above
     )  # [rad] IK seeds; each is also tried with joint 1 turned towards the target.
-    min_pad_depth: float = 0.01  # [m] how far along the pads (the approach) the object must
-    # reach between them: a knife's 12 mm blade lying flat rises only 7 mm above the pads'
-    # lowest point (TABLE_CLEARANCE) and was pressed out of the fingers.
+    min_pad_depth: float = 0.007  # [m] how far along the pads (the approach) the object must
+    # reach between them. A spatula's 12 mm handle lying flat reaches 8 mm above the pads' tips
+    # (TABLE_CLEARANCE over the table) and held when taken straight down; 10 mm refused it. Flat
+    # blades, which this limit kept out at 10 mm, are refused by the checks that came later:
+    # what the camera saw between the pads, `min_pad_overlap` and `min_tool_grip_area`.
     min_pad_overlap: float = 0.005  # [m] how far across the pads' 20 mm width the object must
     # span between them: a 2 mm blade pinched edge-on in a side grasp slides out of the pads.
     min_contact_share: float = 0.5  # the pads must touch the object's widest section over at
@@ -107,6 +109,9 @@ class PlannerConfig:
     # (with the wrist tilted 15°, 28 mm², it held too). The rule also refuses the tilted side
     # grasps on knife blades and screwdriver shafts that slipped or closed on air in S_GRASP (five
     # of those cases were then placed by their handles: placed 112 -> 117 of 132).
+    min_tool_grip_width: float = 0.008  # [m] a tool lying on the table is at least this thick
+    # along the closing axis between the pads (seen points): screwdrivers' 6.6 mm shafts rolled
+    # out of the squeezing pads in all 6 S_GRASP runs that took them (the handles then held).
     torsion_length: float = 0.1  # [m] within a part, candidates are tried in the order of
     # score × exp(−ℓ / torsion_length), ℓ the lever about the closing axis of the object's
     # weight at its perceived centroid (`torsion_lever`): the pads resist that turn by friction
@@ -711,6 +716,13 @@ def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, c
             return (f"the pads would press on only {area * 1e6:.0f} mm² of the tool's lower half "
                     f"(at least {config.min_tool_grip_area * 1e6:.0f} mm²): pressed above its "
                     "widest section, it is squeezed out from between them")
+        seen = _slab_points(target, X_WG, reach=config.open_width / 2,
+                            visible_only=_any_visible(target))
+        grip = float(np.ptp(seen[:, 0])) if len(seen) else float("inf")
+        if grip < config.min_tool_grip_width:
+            return (f"the tool is only {grip * 1000:.0f} mm thick between the pads (at least "
+                    f"{config.min_tool_grip_width * 1000:.0f} mm): a thin shaft rolls out of "
+                    "the squeezing pads")
     if centroid is not None:
         lever = torsion_lever(X_WG, centroid)
         if lever > config.max_torsion_lever:
