@@ -620,11 +620,13 @@ def _contact_share(target: ObjectDescription, X_WG: np.ndarray, open_width: floa
     """Share of the bands across the pads' width that the object fills between the open pads
     (and does not run past them) in which it is about as wide along the closing axis as its
     widest band (within CONTACT_TOLERANCE): where the closing pads touch it first (1 when
-    perception gave no points or no band is left).
-    Measured on the seen points where there are any, as `_depth_between_pads`."""
+    perception gave no points or no band is left). Measured on all points, completed ones too:
+    on the seen ones alone the occluded side of a bottle lying down made the bands of a tilted
+    side grasp differ by more than CONTACT_TOLERANCE, and the grasp that had placed it was
+    refused."""
     if len(target.p_W) == 0:
         return 1.0
-    p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
+    p = _slab_points(target, X_WG, reach=open_width / 2)
     half = PAD_CORNERS_G[:, 2].max()
     band = np.clip(((p[:, 2] + half) / (2 * half) * PAD_BANDS).astype(int), 0, PAD_BANDS - 1)
     # A band where the object reaches out to a pad's inner face runs past that pad (a cup's
