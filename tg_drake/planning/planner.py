@@ -583,16 +583,18 @@ def _extent_along_closing(target: ObjectDescription, X_WG: np.ndarray, band: flo
     return (float(x.min()), float(x.max())) if len(x) else (0.0, 0.0)
 
 
-def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float
-                        ) -> float:
+def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float,
+                        seen: np.ndarray | None = None) -> float:
     """How far along the approach the object reaches between the open pads [m]: from the pads'
     tips back to its nearest point there (inf when perception gave no points: nothing to check).
 
     Measured on the points the camera saw where there are any: symmetry completion mirrors a
-    flat blade about the handle's axis, which makes a 6 mm spatula blade look 16 mm tall."""
+    flat blade about the handle's axis, which makes a 6 mm spatula blade look 16 mm tall.
+    `seen`: those points (`_seen_between_pads`) when the caller has them already, as the
+    overlap and lower-half checks also take them."""
     if len(target.p_W) == 0:
         return float("inf")
-    p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
+    p = _seen_between_pads(target, X_WG, open_width) if seen is None else seen
     return float(PAD_CORNERS_G[:, 1].max() - p[:, 1].min()) if len(p) else 0.0
 
 
@@ -601,14 +603,21 @@ def _any_visible(target: ObjectDescription) -> bool:
     return len(visible) == len(target.p_W) and bool(visible.any())
 
 
-def _overlap_across_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float
-                         ) -> float:
+def _seen_between_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float
+                       ) -> np.ndarray:
+    """The target's points between the open pads (`_slab_points`), only those the camera saw when
+    it saw any: what the checks of `_refusal` measure (completion mirrors a flat blade upwards)."""
+    return _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
+
+
+def _overlap_across_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float,
+                         seen: np.ndarray | None = None) -> float:
     """How far across the pads' width (z_G) the object spans between the open pads [m] (inf when
     perception gave no points). Measured on the points the camera saw where there are any, as
     `_depth_between_pads`."""
     if len(target.p_W) == 0:
         return float("inf")
-    p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
+    p = _seen_between_pads(target, X_WG, open_width) if seen is None else seen
     return float(np.ptp(p[:, 2])) if len(p) else 0.0
 
 
@@ -641,7 +650,8 @@ def _contact_share(target: ObjectDescription, X_WG: np.ndarray, open_width: floa
 
 
 def _pad_area_below_middle(target: ObjectDescription, X_WG: np.ndarray, open_width: float,
-                           table_z: float, cell: float = 0.001) -> float:
+                           table_z: float, cell: float = 0.001, seen: np.ndarray | None = None
+                           ) -> float:
     """Area [m²] of a pad's face that lies over the lower half of the object lying between the
     pads: seen along the closing axis, the face's part that is above the table and below half the
     height of the object's top there (its widest section, for a rounded handle), and within
@@ -654,7 +664,7 @@ def _pad_area_below_middle(target: ObjectDescription, X_WG: np.ndarray, open_wid
     up = X_WG[2, 1:3]  # the world's vertical in the faces' (y_G, z_G) coordinates
     if np.linalg.norm(up) < np.cos(np.deg2rad(30.0)):
         return float("inf")
-    p = _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
+    p = _seen_between_pads(target, X_WG, open_width) if seen is None else seen
     if not len(p):
         return 0.0
     across = np.array([-up[1], up[0]]) / np.linalg.norm(up)  # horizontal, in the faces' plane
@@ -698,11 +708,12 @@ def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, c
     along = _closes_along_length(target, part, X_WG, config)
     if along:
         return along
-    depth = _depth_between_pads(target, X_WG, config.open_width)
+    seen = _seen_between_pads(target, X_WG, config.open_width)  # one selection for the checks
+    depth = _depth_between_pads(target, X_WG, config.open_width, seen)
     if depth < config.min_pad_depth:
         return (f"only {depth * 1000:.0f} mm of the object reaches between the pads (at least "
                 f"{config.min_pad_depth * 1000:.0f} mm): too flat to pick up from the table")
-    overlap = _overlap_across_pads(target, X_WG, config.open_width)
+    overlap = _overlap_across_pads(target, X_WG, config.open_width, seen)
     if overlap < config.min_pad_overlap:
         return (f"the object spans only {overlap * 1000:.0f} mm across the pads' width between "
                 f"them (at least {config.min_pad_overlap * 1000:.0f} mm): a thin edge pinched "
@@ -713,13 +724,11 @@ def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, c
                 f"the width the object fills between them (at least "
                 f"{config.min_contact_share:.0%}): a step or taper under the pads squeezes out")
     if target.is_tool:
-        area = _pad_area_below_middle(target, X_WG, config.open_width, table_z)
+        area = _pad_area_below_middle(target, X_WG, config.open_width, table_z, seen=seen)
         if area < config.min_tool_grip_area:
             return (f"the pads would press on only {area * 1e6:.0f} mm² of the tool's lower half "
                     f"(at least {config.min_tool_grip_area * 1e6:.0f} mm²): pressed above its "
                     "widest section, it is squeezed out from between them")
-        seen = _slab_points(target, X_WG, reach=config.open_width / 2,
-                            visible_only=_any_visible(target))
         grip = float(np.ptp(seen[:, 0])) if len(seen) else float("inf")
         if grip < config.min_tool_grip_width:
             return (f"the tool is only {grip * 1000:.0f} mm thick between the pads (at least "
