@@ -12,8 +12,9 @@ from tg_drake.errors import PerceptionError
 from tg_drake.perception import synthetic as S
 from tg_drake.perception.completion import circle_test, complete
 from tg_drake.perception.config import CompletionConfig
-from tg_drake.perception.geometry import Intrinsics, estimate_normals, make_transform
-from tg_drake.perception.pipeline import describe_cloud
+from tg_drake.perception.geometry import (Intrinsics, estimate_normals, inverse,
+                                          make_transform, transform)
+from tg_drake.perception.pipeline import describe_cloud, describe_object
 from tg_drake.perception.segmentation import segment_depth
 
 NOISE = 0.001  # 1 mm depth noise
@@ -150,3 +151,39 @@ def test_completion_rejects_bad_input():
         complete(np.ones((20, 2)), np.ones((20, 2)))
     with pytest.raises(PerceptionError, match="not above the table"):
         complete(np.column_stack([np.ones((20, 2)), -np.ones(20)]), np.ones((20, 3)))
+
+
+def _lying_library_object(obj_id, yaw_deg, camera):
+    """A library object lying on its side, yawed, seen from one of eval_perception's cameras."""
+    import open3d as o3d
+
+    from tg_drake.objects import get_object, mesh
+
+    obj = get_object(obj_id)
+    V, F, _ = mesh(obj)
+    m = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(np.array(V)),
+                                  o3d.utility.Vector3iVector(np.array(F, dtype=np.int32)))
+    X_TO = make_transform(rz(np.radians(yaw_deg)), [0.0, 0.0, 0.0]) @ obj.poses["sideways"].X_TO
+    az, el, d = {"left": (50.0, 40.0, 0.85), "right": (-50.0, 45.0, 0.85)}[camera]
+    a, e = np.radians(az), np.radians(el)
+    eye = d * np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)]) + [0, 0, 0.05]
+    K = Intrinsics.from_fov(640, 480, np.radians(45.0))
+    X_WC = S.look_at(eye, np.array([0.0, 0.0, 0.05]))
+    depth = S.render_depth([S.table_mesh((0.8, 1.2)), S.placed(m, X_TO)], K, X_WC)
+    scene = segment_depth(depth, K, X_WC)
+    assert len(scene.objects_T) == 1
+    p_TC = transform(inverse(scene.X_WT), eye[None])[0]
+    return X_TO, describe_object(scene.objects_T[0], scene.X_WT, p_TC)
+
+
+@pytest.mark.parametrize("obj_id, yaw_deg, camera", [("pot_01", 0.0, "left"),
+                                                     ("pot_02", 270.0, "right"),
+                                                     ("pot_03", 270.0, "left")])
+def test_a_squat_pot_lying_down_gets_its_axis_from_the_normals(obj_id, yaw_deg, camera):
+    # Seen from the side, a pot lying down shows a nearly square footprint with its handles: W's
+    # box directions were 60-70° off its axis, and the circle test also passed about them. The
+    # axis the normals give is a candidate, and among lying axes that pass alike the one whose
+    # normals meet it (a surface of revolution) is kept.
+    X_TO, o = _lying_library_object(obj_id, yaw_deg, camera)
+    assert o.pose == "sideways"
+    assert abs(o.X_WO[:3, 2] @ X_TO[:3, 2]) > np.cos(np.radians(10))

@@ -188,6 +188,13 @@ def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = No
         evals_t, evecs_t = np.linalg.eigh(np.cov(W[top].T))
         if evals_t[1] > RIDGE_EIGEN_RATIO * max(evals_t[0], 1e-12):
             directions.append(evecs_t[:, 1] * (1.0 if evecs_t[0, 1] >= 0 else -1.0))
+    # And the axis the normals give (`_normal_axis`): a squat pot lying down shows W neither
+    # along nor across its axis, and its circle test passes about wrong horizontal axes too.
+    for start in (e1, e2):
+        normal_axis = _normal_axis(n_T, np.append(start, 0.0))
+        if normal_axis is not None and np.linalg.norm(normal_axis[:2]) > 0:
+            d_n = normal_axis[:2] / np.linalg.norm(normal_axis[:2])
+            directions.append(d_n * (1.0 if d_n[0] >= 0 else -1.0))
     candidates = [_vertical_candidate(W, top, c_top, d_z, e1, e2, cfg)]
     # A tilted lying axis is tried along W's long direction and the top ridge only.
     # (Not when the vertical circle is already perfect: a tilted one could at best tie.)
@@ -203,6 +210,10 @@ def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = No
     if passing:
         best = max(c.fit.confidence for c in passing)
         passing = [c for c in passing if c.fit.confidence >= best - CONFIDENCE_TIE]
+    if len(passing) > 1 and all(not c.vertical for c in passing):
+        # Lying axes as sure as each other: the one about which the surface is most nearly
+        # a surface of revolution (its normals meet the axis).
+        passing = [min(passing, key=lambda c: _revolution_residual(p_T, n_T, c))]
     if len(passing) == 1:
         chosen, margin = passing[0], passing[0].fit.confidence
     else:
@@ -335,6 +346,16 @@ def _robust_circle(q: np.ndarray, tolerance: float) -> tuple[np.ndarray, float] 
         radius = float(np.sqrt(max(sol[2] + centre @ centre, 0.0)))
         keep = np.abs(np.hypot(x - centre[0], y - centre[1]) - radius) <= tolerance * radius
     return (centre, radius) if radius > 0 else None
+
+
+def _revolution_residual(p: np.ndarray, n: np.ndarray, c: _Candidate) -> float:
+    """Median sine of the angle between each normal and the plane through the candidate's
+    axis and its point: 0 on a surface of revolution about the axis (walls and end faces),
+    whatever the points' spread along or around it."""
+    m = np.cross(c.a, p - c.p_TA)
+    norm = np.linalg.norm(m, axis=1)
+    ok = norm > 1e-6
+    return float(np.median(np.abs(np.einsum("ij,ij->i", n[ok], m[ok])) / norm[ok]))
 
 
 def _normal_axis(n: np.ndarray, a0: np.ndarray) -> np.ndarray | None:
