@@ -587,3 +587,27 @@ def test_a_thin_tool_shaft_is_refused():
                                      closing_W=[0, 1, 0]), 0.0)
     assert "thin shaft" in _refusal(bar(0.006), "handle", down, None, config)
     assert _refusal(bar(0.012), "handle", down, None, config) == ""
+
+
+def test_an_open_pad_coming_down_on_the_object_is_refused():
+    from tg_drake.planning.planner import _open_pad_cover, _refusal
+
+    config = PlannerConfig()
+    # A top-down grasp closing along y over a 30 mm block (a hammer's head); a 25 mm bar (its
+    # handle) runs from it along y under where the right pad comes down (y 55 to 67 mm).
+    X = grasp_pose([0.75, 0.0, 0.02], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
+    g = np.linspace(-0.015, 0.015, 16)
+    head = np.stack(np.meshgrid(g, g, [0.035]), -1).reshape(-1, 3) + [0.75, 0.0, 0.0]
+    bar = np.stack(np.meshgrid(np.linspace(-0.0125, 0.0125, 7), np.linspace(0.015, 0.1, 44),
+                               [0.025]), -1).reshape(-1, 3) + [0.75, 0.0, 0.0]
+    o = box_object([0.75, 0.0, 0.0175], [0.03, 0.03, 0.035], parts=("usable_area",))
+    o.p_W = head
+    assert _open_pad_cover(o, X, config.open_width) == 0.0
+    o.p_W = np.vstack([head, bar])
+    assert _open_pad_cover(o, X, config.open_width) > config.max_pad_cover
+    o.is_tool = True
+    assert "come down on the object" in _refusal(o, "usable_area", X, None, config)
+    # A container's wall or handle under a pad yields (a cup's handle did, and the grasp held):
+    # the check is for tools lying on the table only.
+    o.is_tool = False
+    assert "come down on the object" not in _refusal(o, "usable_area", X, None, config)

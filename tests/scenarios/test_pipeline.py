@@ -63,11 +63,6 @@ def test_default_scenario_passes_the_cup_by_its_middle():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason=(
-    "known failure since session 2's planner (fails at bb32a56 too): the logic and the part "
-    "are right, but the head grasp that is planned closes across the head's thickness with one "
-    "pad landing on the handle where it joins the head, so the hammer is not lifted (rose 0.0 "
-    "cm); the grasp across the head's length is refused by the closes-along-its-length rule"))
 def test_hammer_for_pass_is_taken_by_the_usable_area():
     result = run("hammer_pass")
     check_result_keys(result)

@@ -112,6 +112,11 @@ class PlannerConfig:
     min_tool_grip_width: float = 0.008  # [m] a tool lying on the table is at least this thick
     # along the closing axis between the pads (seen points): screwdrivers' 6.6 mm shafts rolled
     # out of the squeezing pads in all 6 S_GRASP runs that took them (the handles then held).
+    max_pad_cover: float = 1.0 / 3.0  # an open pad may come down over a tool lying on the table
+    # on at most this share of its cross-section (`_open_pad_cover`): over a hammer's handle
+    # (67-87 %) the pad stopped on it and the head grasp lifted nothing. Not applied to
+    # containers: S_ROBOT's cups, taken by the middle with the handle under a pad (53-73 %), held,
+    # and a pot lying down was refused every grasp.
     torsion_length: float = 0.1  # [m] within a part, candidates are tried in the order of
     # score × exp(−ℓ / torsion_length), ℓ the lever about the closing axis of the object's
     # weight at its perceived centroid (`torsion_lever`): the pads resist that turn by friction
@@ -679,13 +684,38 @@ def _pad_area_below_middle(target: ObjectDescription, X_WG: np.ndarray, open_wid
     return float(below.sum() * cell ** 2)
 
 
+PAD_THICKNESS = 0.012  # [m] the pads' thickness along x_G, outwards from their inner faces
+PAD_CELL = 0.004  # [m] cells of a pad's 12 × 20 mm cross-section (3 × 5), perception's voxel
+
+
+def _open_pad_cover(target: ObjectDescription, X_WG: np.ndarray, open_width: float) -> float:
+    """The larger, of the two open pads, share of a pad's cross-section across the approach
+    (PAD_CELL cells over its thickness and width) under which the camera saw the object within
+    the pad's length: where the pad would come down on the object instead of beside it."""
+    if len(target.p_W) == 0:
+        return 0.0
+    p = _slab_points(target, X_WG, reach=open_width / 2 + PAD_THICKNESS,
+                     visible_only=_any_visible(target))
+    half = PAD_CORNERS_G[:, 2].max()
+    nx, nz = int(round(PAD_THICKNESS / PAD_CELL)), int(round(2 * half / PAD_CELL))
+    cover = 0.0
+    for side in (-1.0, 1.0):
+        q = p[side * p[:, 0] > open_width / 2]
+        if len(q):
+            i = np.clip(((side * q[:, 0] - open_width / 2) / PAD_CELL).astype(int), 0, nx - 1)
+            k = np.clip(((q[:, 2] + half) / PAD_CELL).astype(int), 0, nz - 1)
+            cover = max(cover, len(set(zip(i.tolist(), k.tolist()))) / (nx * nz))
+    return cover
+
+
 def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, config,
              table_z: float = 0.0) -> str:
     """Why the geometry of the grasp X_WG on `part` rules it out before any IK ("" if it does
     not): the part or the object does not fit the opening, the fingers would close along a long
     part, too little of the object reaches between the pads, the pads would touch it first in
     only part of the width it fills or press only on the upper half of a tool lying on the table
-    (its top at height `table_z`), or the object's weight would turn it in the pads. `centroid`:
+    (its top at height `table_z`), an open pad would come down on a tool, or the object's weight
+    would turn it in the pads. `centroid`:
     the object's perceived centroid (None: no points)."""
     width = _part_width(target, part, X_WG)
     if width > config.open_width - config.width_margin:
@@ -705,6 +735,12 @@ def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, c
         return (f"the object reaches past both pads ({hi - lo:.3f} m along the closing axis "
                 f"there; its {part} {width:.3f} m): the WSG, open to {config.open_width} m, "
                 "could not let go")
+    # Tools only: what lies under a pad of a tool lying on the table rests on the table and
+    # stops the pad; a container's wall or handle under a pad may yield (`max_pad_cover`).
+    cover = _open_pad_cover(target, X_WG, config.open_width) if target.is_tool else 0.0
+    if cover > config.max_pad_cover:
+        return (f"an open pad would come down on the object (it lies under {cover:.0%} of the "
+                f"pad's cross-section, at most {config.max_pad_cover:.0%})")
     along = _closes_along_length(target, part, X_WG, config)
     if along:
         return along
