@@ -715,8 +715,7 @@ def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, c
     part, too little of the object reaches between the pads, the pads would touch it first in
     only part of the width it fills or press only on the upper half of a tool lying on the table
     (its top at height `table_z`), an open pad would come down on a tool, or the object's weight
-    would turn it in the pads. `centroid`:
-    the object's perceived centroid (None: no points)."""
+    would turn it in the pads. `centroid`: the object's perceived centroid (None: no points)."""
     width = _part_width(target, part, X_WG)
     if width > config.open_width - config.width_margin:
         # The box overstates what lies between the fingers for a grasp across a wall (a rim
