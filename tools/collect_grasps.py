@@ -10,6 +10,7 @@ to the data and, with --summary, to docs/results/dgi_dataset_summary.json.
 
     nice -n 10 python tools/collect_grasps.py --out data/dgi/grasps.jsonl --workers 1
     python tools/collect_grasps.py --objects cup_01,knife_02 --out data/dgi/try.jsonl
+    python tools/collect_grasps.py --object-mass 0.1 --workers 2 --out data/dgi/grasps_light.jsonl
     python tools/collect_grasps.py --executor ray --address auto --out data/dgi/grasps.jsonl
 """
 
@@ -91,13 +92,18 @@ def main(argv=None) -> int:
     parser.add_argument("--address", help="Ray cluster address (with --executor ray)")
     parser.add_argument("--batch", type=int, default=20, help="grasps per job")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--object-mass", type=float, default=0.0,
+                        help="> 0: every object weighs this much [kg] (its inertia scaled, its "
+                             "shape and centre of mass kept): labels of local shape alone")
     parser.add_argument("--summary", type=Path,
                         help="also write the summary here (docs/results/dgi_dataset_summary.json)")
     args = parser.parse_args(argv)
 
     objects = ([get_object(o) for o in args.objects.split(",")] if args.objects
                else list(load_library().values()))
-    episode = EpisodeConfig()
+    if args.object_mass < 0:
+        parser.error(f"--object-mass must be ≥ 0 kg, got {args.object_mass}")
+    episode = EpisodeConfig(object_mass=args.object_mass)
     jobs, through_table = make_jobs(objects, seed=args.seed, batch=args.batch,
                                     sampling=SamplingConfig(), episode=episode)
     n_grasps = sum(len(j.payload["grasps"]) for j in jobs)

@@ -121,3 +121,19 @@ def test_the_script_approaches_closes_lifts_and_shakes_back_to_rest():
         assert t["carrier_rz"] == (0.0, 0.0)
         # Desired velocities are zero at rest (1e-12: rounding of the sin² envelope).
         assert all(abs(qv[1]) < 1e-12 for qv in t.values())
+
+
+def test_object_mass_scales_the_inertia_and_keeps_the_centre_of_mass(tmp_path):
+    path = tmp_path / "cylinder.sdf"
+    path.write_text(CYLINDER_SDF)
+    world = GraspWorld(str(path), EpisodeConfig(object_mass=0.1))
+    context = world.plant.GetMyContextFromRoot(world.context)
+    M = world.object_body.CalcSpatialInertiaInBodyFrame(context)
+    assert M.get_mass() == pytest.approx(0.1)
+    np.testing.assert_allclose(M.get_com(), [0, 0, 0], atol=1e-12)
+    # A third of the 0.3 kg model's inertia: the same shape, a third of its density.
+    np.testing.assert_allclose(M.CalcRotationalInertia().get_moments(),
+                               np.array([3.32e-4, 3.32e-4, 1.63e-4]) / 3, rtol=1e-6)
+    result = world.run(X_WO, top_down([0, 0, HEIGHT + 0.01]))  # the context's mass persists
+    assert result["status"] == "ok" and result["success"]
+    assert world.object_body.CalcSpatialInertiaInBodyFrame(context).get_mass() == pytest.approx(0.1)

@@ -85,6 +85,8 @@ class EpisodeConfig:
     carrier_torque_limit: float = 15.0  # [N·m] per rotation joint.
     min_finger_gap: float = 0.002  # fingers closer than this closed on nothing [m].
     min_finger_travel: float = 0.005  # each finger must have closed at least this much [m].
+    object_mass: float = 0.0  # > 0: the object's inertia scaled to this mass [kg] (same shape and
+    # centre of mass): labels that do not depend on how heavy the object is.
 
     @property
     def duration(self) -> float:
@@ -250,6 +252,12 @@ class GraspWorld:
         self.simulator = Simulator(self.diagram)
         self.context = self.simulator.get_mutable_context()
         self._default_state = self.context.get_discrete_state_vector().CopyToVector()
+        if config.object_mass > 0:
+            from pydrake.multibody.tree import SpatialInertia
+            M = self.object_body.default_spatial_inertia()
+            self.object_body.SetSpatialInertiaInBodyFrame(
+                plant.GetMyMutableContextFromRoot(self.context),
+                SpatialInertia(config.object_mass, M.get_com(), M.get_unit_inertia()))
 
     def run(self, X_WO: np.ndarray, X_WG: np.ndarray) -> dict:
         """Executes one grasp on the object resting at X_WO with the gripper closing at X_WG.
