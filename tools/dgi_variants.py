@@ -18,6 +18,7 @@ import argparse
 import json
 import sys
 import time
+from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -117,6 +118,44 @@ def learning_curve(X, data, fractions=(0.25, 0.5, 0.75, 1.0), gamma=0.03) -> dic
     return curve
 
 
+def mass_free_labels(records: list[dict], light: list[dict], seed: int, mass: float) -> dict:
+    """The shipped feature and SVM on labels from the same grasps executed with every object at
+    one light mass (`tools/collect_grasps.py --object-mass`): accuracy on those labels, and the
+    model trained on them judged by the real-mass labels (grasps executed fine in both sets)."""
+    from sklearn.model_selection import GroupKFold
+    from sklearn.svm import SVC
+
+    from tg_drake.objects import get_object
+    from train_dgi import top_grasp_accuracy
+
+    shipped = VARIANTS[0]
+    X, data = features(light, shipped, seed)
+    own = evaluate(shipped, X, data)
+    real = {(r["job"], r["index"]): r for r in records if r.get("status") == "ok"}
+    both = [r for r in light if r.get("status") == "ok" and (r["job"], r["index"]) in real]
+    X, data = features(both, shipped, seed)
+    by_scene: dict = {}
+    for r in both:  # training_set's order: scenes sorted, the file's order within a scene
+        by_scene.setdefault((r["object"], r["pose"]), []).append(r)
+    y_real = np.array([int(real[(r["job"], r["index"])]["success"])
+                       for key in sorted(by_scene) for r in by_scene[key]])
+    f = np.empty(len(data.y))
+    for train, test in GroupKFold(4).split(X, data.y, groups=data.object_ids):
+        f[test] = SVC(kernel="rbf", gamma=own["gamma"], C=1.0).fit(
+            X[train], data.y[train]).decision_function(X[test])
+    same = defaultdict(list)
+    for r, y in zip((r for key in sorted(by_scene) for r in by_scene[key]), y_real):
+        same[get_object(r["object"]).category].append(int(r["success"]) == y)
+    ok = [r for r in light if r.get("status") == "ok"]
+    return {"mass_kg": mass, "n_grasps": len(ok), "n_positive": sum(bool(r["success"]) for r in ok),
+            "n_ok_both": len(both), **{k: own[k] for k in (
+                "gamma", "cv_accuracy", "objectwise_accuracy", "top_grasp_accuracy")},
+            "judged_by_real_labels": {
+                "objectwise_accuracy": float(np.mean((f > 0) == y_real)),
+                "top_grasp_accuracy": top_grasp_accuracy(f, y_real, data.scenes)["accuracy"]},
+            "same_label_per_category": {c: float(np.mean(v)) for c, v in sorted(same.items())}}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--data", type=Path, default=Path("data/dgi/grasps.jsonl"))
@@ -126,6 +165,11 @@ def main(argv=None) -> int:
     parser.add_argument("--learning-curve", action="store_true",
                         help="the shipped feature's accuracy on unseen objects against the share "
                         "of training grasps (only that, unless --variants is given)")
+    parser.add_argument("--mass-free", type=Path, metavar="DATA",
+                        help="grasps collected with --object-mass: compare their labels (only "
+                        "that, unless --variants is given)")
+    parser.add_argument("--mass-free-kg", type=float, default=0.1,
+                        help="the --object-mass those grasps were collected with [kg]")
     parser.add_argument("--merge", action="store_true",
                         help="add to the variants already in --out instead of replacing them")
     args = parser.parse_args(argv)
@@ -145,12 +189,21 @@ def main(argv=None) -> int:
         results = previous["variants"]
         commands = previous.get("commands") or [previous["command"]]
         curve = previous.get("learning_curve")
+        mass_free = previous.get("mass_free_labels")
+    else:
+        mass_free = None
+    if args.mass_free:
+        light = [json.loads(line) for line in args.mass_free.read_text().splitlines()
+                 if line.strip()]
+        mass_free = mass_free_labels(records, light, args.seed, args.mass_free_kg)
+        print("mass-free labels", json.dumps(mass_free), flush=True)
     if args.learning_curve:
         X, data = features(records, VARIANTS[0], args.seed)
         curve = learning_curve(X, data)
         print("learning curve", json.dumps(curve), flush=True)
     for variant in VARIANTS:
-        if variant.name not in chosen or (args.learning_curve and not args.variants):
+        if variant.name not in chosen or ((args.learning_curve or args.mass_free)
+                                          and not args.variants):
             continue
         start = time.perf_counter()
         X, data = features(records, variant, args.seed)
@@ -163,9 +216,11 @@ def main(argv=None) -> int:
     commands.append("nice -n 10 .venv/bin/python tools/dgi_variants.py " + " ".join(
         sys.argv[1:] if argv is None else argv))
     out = {"variants": results, "best_by_cv_accuracy": best, "C": 1.0,
-           "n_grasps": int(len(data.y)), "commands": commands}
+           "n_grasps": int(sum(r.get("status") == "ok" for r in records)), "commands": commands}
     if curve:
         out["learning_curve"] = curve
+    if mass_free:
+        out["mass_free_labels"] = mass_free
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(out, indent=1) + "\n")
     print(f"best by cross-validated accuracy: {best}")
