@@ -137,14 +137,17 @@ def mass_free_labels(records: list[dict], light: list[dict], seed: int, mass: fl
     by_scene: dict = {}
     for r in both:  # training_set's order: scenes sorted, the file's order within a scene
         by_scene.setdefault((r["object"], r["pose"]), []).append(r)
-    y_real = np.array([int(real[(r["job"], r["index"])]["success"])
-                       for key in sorted(by_scene) for r in by_scene[key]])
+    ordered = [r for key in sorted(by_scene) for r in by_scene[key]]
+    if [int(r["success"]) for r in ordered] != data.y.tolist():
+        raise RuntimeError("training_set no longer orders grasps by scene, then as in the file: "
+                           "the real-mass labels would not line up with the features")
+    y_real = np.array([int(real[(r["job"], r["index"])]["success"]) for r in ordered])
     f = np.empty(len(data.y))
     for train, test in GroupKFold(4).split(X, data.y, groups=data.object_ids):
         f[test] = SVC(kernel="rbf", gamma=own["gamma"], C=1.0).fit(
             X[train], data.y[train]).decision_function(X[test])
     same = defaultdict(list)
-    for r, y in zip((r for key in sorted(by_scene) for r in by_scene[key]), y_real):
+    for r, y in zip(ordered, y_real):
         same[get_object(r["object"]).category].append(int(r["success"]) == y)
     ok = [r for r in light if r.get("status") == "ok"]
     return {"mass_kg": mass, "n_grasps": len(ok), "n_positive": sum(bool(r["success"]) for r in ok),

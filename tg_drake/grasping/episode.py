@@ -253,7 +253,6 @@ class GraspWorld:
         self.context = self.simulator.get_mutable_context()
         self._default_state = self.context.get_discrete_state_vector().CopyToVector()
         if config.object_mass > 0:
-            from pydrake.multibody.tree import SpatialInertia
             M = self.object_body.default_spatial_inertia()
             self.object_body.SetSpatialInertiaInBodyFrame(
                 plant.GetMyMutableContextFromRoot(self.context),

@@ -704,7 +704,7 @@ def _open_pad_cover(target: ObjectDescription, X_WG: np.ndarray, open_width: flo
         if len(q):
             i = np.clip(((side * q[:, 0] - open_width / 2) / PAD_CELL).astype(int), 0, nx - 1)
             k = np.clip(((q[:, 2] + half) / PAD_CELL).astype(int), 0, nz - 1)
-            cover = max(cover, len(set(zip(i.tolist(), k.tolist()))) / (nx * nz))
+            cover = max(cover, np.unique(i * nz + k).size / (nx * nz))
     return cover
 
 
