@@ -120,6 +120,7 @@ def main(argv=None) -> int:
     records = [json.loads(line) for line in args.out.read_text().splitlines() if line.strip()]
     records = [r for r in records if r["job"] in keys]
     summary = summarise(records, seed=args.seed, through_table=through_table)
+    summary["object_mass_kg"] = args.object_mass or None  # None: every object at its own mass
     ran = sum(len(j.payload["grasps"]) for j in jobs if j.key not in done)
     summary["this_run"] = {"grasps": ran, "wall_seconds": wall, "workers": args.workers,
                            "executor": args.executor,

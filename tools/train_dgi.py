@@ -18,7 +18,16 @@ computes DGI features, then (paper section V-C):
    writes tg_drake/data/dgi_svm.joblib, docs/results/dgi.json and docs/results/dgi.md. The
    "label_repeatability" entry that tools/label_noise.py merged into dgi.json is kept and reported.
 
-    nice -n 10 .venv/bin/python tools/train_dgi.py --data data/dgi/grasps.jsonl
+The shipped model learns from labels collected with every object at 0.1 kg (collect_grasps.py
+--object-mass 0.1: whether the local shape affords a grasp, as the paper's hand-labelled rectangles
+judged); the same protocol on the real-mass labels is kept beside it as a reference
+(docs/results/dgi_real_mass.json, no model written), and --judge-data scores the shipped model's
+held-out top grasps by those labels too:
+
+    nice -n 10 .venv/bin/python tools/train_dgi.py --data data/dgi/grasps_light.jsonl \
+        --object-mass 0.1 --judge-data data/dgi/grasps.jsonl
+    nice -n 10 .venv/bin/python tools/train_dgi.py --data data/dgi/grasps.jsonl \
+        --object-mass 0 --name dgi_real_mass --no-model
     .venv/bin/python tools/train_dgi.py --markdown-only   # dgi.md from dgi.json
 """
 
@@ -36,7 +45,7 @@ import numpy as np
 from sklearn.model_selection import GridSearchCV, GroupKFold, StratifiedKFold
 from sklearn.svm import SVC
 
-from tg_drake.grasping.dataset import SamplingConfig, training_set
+from tg_drake.grasping.dataset import SamplingConfig, training_order, training_set
 from tg_drake.grasping.dgi import DgiConfig
 from tg_drake.grasping.model import DgiGraspModel
 from tg_drake.grasping.svm import PlattSvmClassifier
@@ -172,20 +181,27 @@ def nonlocal_accuracy(X, y, data, gamma, C, folds: dict) -> dict:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--data", type=Path, default=Path("data/dgi/grasps.jsonl"))
+    parser.add_argument("--data", type=Path, default=Path("data/dgi/grasps_light.jsonl"))
     parser.add_argument("--seed", type=int, default=0, help="the collection's seed")
     parser.add_argument("--model-out", type=Path,
                         default=Path(str(files("tg_drake"))) / "data" / "dgi_svm.joblib")
     parser.add_argument("--results", type=Path, default=Path("docs/results"))
     parser.add_argument("--markdown-only", action="store_true",
                         help="only write dgi.md again from dgi.json (after tools/label_noise.py)")
+    parser.add_argument("--judge-data", type=Path, metavar="DATA",
+                        help="the same grasps executed with other object masses (the real ones: "
+                        "data/dgi/grasps.jsonl): judge the held-out scores by their labels too")
+    parser.add_argument("--name", default="dgi",
+                        help="results file RESULTS/NAME.json; only the shipped model's run (dgi) "
+                        "writes dgi.md, which shows REFERENCE_NAME.json beside it")
+    parser.add_argument("--object-mass", type=float, default=0.1,
+                        help="the collect_grasps.py --object-mass of --data [kg] (0: every "
+                        "object at its own mass), for the report")
+    parser.add_argument("--no-model", action="store_true",
+                        help="evaluate only; leave the shipped model file alone")
     args = parser.parse_args(argv)
     if args.markdown_only:
-        results = json.loads((args.results / "dgi.json").read_text())
-        variants = args.results / "dgi_variants.json"
-        if variants.is_file():
-            results["variants"] = json.loads(variants.read_text())
-        (args.results / "dgi.md").write_text(markdown(results))
+        write_markdown(args.results, json.loads((args.results / "dgi.json").read_text()))
         return 0
     start = time.perf_counter()
 
@@ -214,6 +230,9 @@ def main(argv=None) -> int:
     top_pregrasp = top_grasp_accuracy(p_obj[box], y[box], data.scenes[box])
     print(f"cv accuracy {cv_accuracy:.4f}, object-wise {np.mean((p_obj >= 0.5) == y):.4f}, "
           f"top grasp {top['accuracy']:.4f}", flush=True)
+    judged = judged_by(args.judge_data, records, p_obj, data) if args.judge_data else None
+    if judged:
+        print("judged by", args.judge_data, json.dumps(judged), flush=True)
 
     # 4. what mass and category explain.
     nonlocal_ = nonlocal_accuracy(X, y, data, gamma, C,
@@ -248,6 +267,7 @@ def main(argv=None) -> int:
                                              for c, v in sorted(per_category.items())},
         "objectwise_nested_params": nested_params,
         "nonlocal_factors": nonlocal_,
+        **({"judged_by_other_labels": judged} if judged else {}),
         "svm_grid_best_accuracy": float(search.best_score_),
         "gamma": float(gamma),
         "C": float(C),
@@ -263,28 +283,74 @@ def main(argv=None) -> int:
         "command": "nice -n 10 .venv/bin/python tools/train_dgi.py " + " ".join(
             sys.argv[1:] if argv is None else argv),
     }
-    model = DgiGraspModel(final, config, info={k: results[k] for k in (
-        "n_grasps", "n_positive", "cv_accuracy", "top_grasp_accuracy", "gamma", "C", "A", "b")})
-    model.save(args.model_out)
-    results["model_bytes"] = args.model_out.stat().st_size
+    if not args.no_model:
+        model = DgiGraspModel(final, config, info={"data": args.data.name, **{
+            k: results[k] for k in ("n_grasps", "n_positive", "cv_accuracy",
+                                    "top_grasp_accuracy", "gamma", "C", "A", "b")}})
+        model.save(args.model_out)
+        results["model_bytes"] = args.model_out.stat().st_size
+    results["data"] = args.data.name
+    results["object_mass_kg"] = args.object_mass or None
     args.results.mkdir(parents=True, exist_ok=True)
-    previous = args.results / "dgi.json"
+    previous = args.results / f"{args.name}.json"
     if previous.is_file():  # tools/label_noise.py's studies, kept across retraining.
         results.update({k: v for k, v in json.loads(previous.read_text()).items()
                         if k.startswith("label_repeatability")})
-    variants = args.results / "dgi_variants.json"  # tools/dgi_variants.py, if it was run.
-    if variants.is_file():
-        results["variants"] = json.loads(variants.read_text())
-    (args.results / "dgi.json").write_text(json.dumps(results, indent=1) + "\n")
-    (args.results / "dgi.md").write_text(markdown(results))
+    previous.write_text(json.dumps(results, indent=1) + "\n")
+    if args.name == "dgi":
+        write_markdown(args.results, results)
     print(json.dumps({k: v for k, v in results.items() if not isinstance(v, dict)}, indent=1))
     return 0
 
 
-def markdown(r: dict) -> str:
+REFERENCE_NAME = "dgi_real_mass"  # the same protocol on the labels with the objects' real masses
+
+
+def write_markdown(results_dir: Path, results: dict) -> None:
+    """dgi.md from dgi.json, with tools/dgi_variants.py's results and the real-mass reference."""
+    results = dict(results)
+    variants = results_dir / "dgi_variants.json"  # tools/dgi_variants.py, if it was run.
+    if variants.is_file():
+        results["variants"] = json.loads(variants.read_text())
+    reference = results_dir / f"{REFERENCE_NAME}.json"
+    ref = json.loads(reference.read_text()) if reference.is_file() else None
+    (results_dir / "dgi.md").write_text(markdown(results, ref))
+
+
+def judged_by(path: Path, records: list[dict], p: np.ndarray, data) -> dict:
+    """The held-out probabilities `p` (rows of `training_set(records)`) judged by the labels of
+    the same jobs in another collection (`path`), on the grasps that ran fine in both."""
+    other = {(r["job"], r["index"]): int(r["success"])
+             for r in (json.loads(line) for line in path.read_text().splitlines() if line.strip())
+             if r.get("status") == "ok"}
+    keys = [(r["job"], r["index"]) for r in training_order(records)]
+    both = np.array([k in other for k in keys])
+    y_other = np.array([other[k] for k in keys if k in other])
+    top = top_grasp_accuracy(p[both], y_other, data.scenes[both])
+    return {"data": path.name, "n_grasps": int(both.sum()),
+            "same_label": float(np.mean(y_other == data.y[both])),
+            "objectwise_accuracy": float(np.mean((p[both] >= 0.5) == y_other)),
+            "top_grasp_accuracy": top["accuracy"], "top_grasp": top}
+
+
+def labels_name(r: dict) -> str:
+    mass = r.get("object_mass_kg")
+    return f"every object at {mass:g} kg" if mass else "the objects' real masses"
+
+
+def markdown(r: dict, ref: dict | None = None) -> str:
+    """dgi.md: the shipped model's results `r`, and `ref` (the same protocol on other labels of
+    the same grasps: the real masses) beside them when given."""
     paper = r["paper"]
-    top = r["top_grasp"]
-    pre = r["top_grasp_pregrasp"]
+    cols = [r] + ([ref] if ref else [])
+
+    def row(label, value, paper_value="–"):
+        return f"| {label} | " + " | ".join(value(x) for x in cols) + f" | {paper_value} |"
+
+    def pct(x):
+        return f"{100 * x:.2f} %"
+
+    judged = r.get("judged_by_other_labels")
     lines = [
         "# DGI local-shape grasp classifier",
         "",
@@ -295,28 +361,57 @@ def markdown(r: dict) -> str:
         "stayed between the fingers; the paper's were the hand-labelled grasping-rectangle images",
         "of Jiang et al.",
         "",
-        "| | ours | paper |",
-        "|---|---|---|",
-        f"| grasps (positive / negative) | {r['n_grasps']} ({r['n_positive']} / {r['n_negative']}) "
-        f"| {paper['paper_n_grasps']} ({paper['paper_n_positive']} / "
-        f"{paper['paper_n_grasps'] - paper['paper_n_positive']}) |",
-        f"| 4-fold cross-validated accuracy | {100 * r['cv_accuracy']:.2f} % | – |",
-        f"| same, folds by object (unseen objects) | {100 * r['objectwise_cv_accuracy']:.2f} % "
-        "| – |",
-        f"| top-grasp accuracy (unseen objects) | {100 * r['top_grasp_accuracy']:.2f} % "
-        f"({top['n_scenes']} scenes) | {paper['paper']} |",
-        f"| same, a random grasp of the scene instead | {100 * top['random_grasp_accuracy']:.2f} % "
-        "| – |",
-        f"| top-grasp accuracy (folds not by object) | "
-        f"{100 * r['top_grasp_seen_objects']['accuracy']:.2f} % | – |",
-        f"| top grasp among the part-box pre-grasps only (unseen objects) | "
-        f"{100 * pre['accuracy']:.2f} % ({pre['n_scenes']} scenes; random pick "
-        f"{100 * pre['random_grasp_accuracy']:.2f} %) | – |",
-        f"| γ | {r['gamma']:g} | {paper['paper_gamma']:g} |",
-        f"| C | {r['C']:g} | – |",
-        f"| A, b | {r['A']:.3f}, {r['b']:.3f} | {paper['paper_A']:g}, {paper['paper_b']:g} |",
+    ]
+    if ref:
+        lines += [
+            f"The shipped model learns from labels with {labels_name(r)} (`tools/collect_grasps.py",
+            f"--object-mass`): the same {r['n_grasps']} grasps, executed with each object's inertia",
+            "scaled to that mass, its shape and centre of mass kept. Whether the local shape affords",
+            "a grasp is what the paper's hand-labelled rectangles judged and what its",
+            "P(grasp | local shape) means; with the real masses a pan's handle fails under the",
+            "pan's 1–2.5 kg whatever its shape, a fact about the object that a 7 mm depth image",
+            "cannot see (section \"Labels without the object's weight\"). Judged by the real-mass",
+            "labels, the shipped model does as well as one trained on them (row \"judged by the",
+            "real-mass labels\" below); in the pipeline the planner's lever ordering and the logic",
+            "carry the weight. The right-hand column runs the same protocol on the real-mass labels.",
+            "",
+        ]
+    lines += [
+        "| | ours" + (f", shipped: {labels_name(r)} | ours: {labels_name(ref)}" if ref else "")
+        + " | paper |",
+        "|---|---" + ("|---" if ref else "") + "|---|",
+        row("grasps (positive / negative)",
+            lambda x: f"{x['n_grasps']} ({x['n_positive']} / {x['n_negative']})",
+            f"{paper['paper_n_grasps']} ({paper['paper_n_positive']} / "
+            f"{paper['paper_n_grasps'] - paper['paper_n_positive']})"),
+        row("4-fold cross-validated accuracy", lambda x: pct(x["cv_accuracy"])),
+        row("same, folds by object (unseen objects)",
+            lambda x: pct(x["objectwise_cv_accuracy"])),
+        row("top-grasp accuracy (unseen objects)",
+            lambda x: f"{pct(x['top_grasp_accuracy'])} ({x['top_grasp']['n_scenes']} scenes)",
+            str(paper["paper"])),
+    ]
+    if judged:
+        lines.append(row(
+            "same scores, judged by the real-mass labels",
+            lambda x: (f"{pct(judged['top_grasp_accuracy'])} ({judged['top_grasp']['n_scenes']} "
+                       f"scenes; unseen objects' grasps {pct(judged['objectwise_accuracy'])})"
+                       if x is r else "–")))
+    lines += [
+        row("same, a random grasp of the scene instead",
+            lambda x: pct(x["top_grasp"]["random_grasp_accuracy"])),
+        row("top-grasp accuracy (folds not by object)",
+            lambda x: pct(x["top_grasp_seen_objects"]["accuracy"])),
+        row("top grasp among the part-box pre-grasps only (unseen objects)",
+            lambda x: (f"{pct(x['top_grasp_pregrasp']['accuracy'])} "
+                       f"({x['top_grasp_pregrasp']['n_scenes']} scenes; random pick "
+                       f"{pct(x['top_grasp_pregrasp']['random_grasp_accuracy'])})")),
+        row("γ", lambda x: f"{x['gamma']:g}", f"{paper['paper_gamma']:g}"),
+        row("C", lambda x: f"{x['C']:g}"),
+        row("A, b", lambda x: f"{x['A']:.3f}, {x['b']:.3f}",
+            f"{paper['paper_A']:g}, {paper['paper_b']:g}"),
         "",
-        *summary_markdown(r),
+        *summary_markdown(r, ref),
         "Grasping accuracy of the paper's Table (top grasp per image, rectangle dataset):",
         f"Jiang et al. {paper['jiang_et_al']}, Lenz et al. {paper['lenz_et_al']}, "
         f"the paper {paper['paper']}.",
@@ -325,47 +420,65 @@ def markdown(r: dict) -> str:
         "highest P(grasp | local shape) among the scene's executed grasps is taken; it is right",
         "when it held. Scores come from models trained on the other objects (4 folds grouped by",
         "object, γ and C chosen on those objects alone); scenes without any successful grasp "
-        f"({top['n_scenes_without_positive']}) are left out.",
+        f"({r['top_grasp']['n_scenes_without_positive']}) are left out.",
         "",
-        "Scenes whose top grasp failed: " + ", ".join(top["wrong_scenes"]) + ".",
-        "Local shape cannot see mass: a pan (1–2.5 kg) or a full-size pot held by its handle",
-        "or rim turns in the pads and drags on the table although the handle looks as graspable",
-        "as a glass, and light bowls and bottles are pushed away by a pad that lands on them.",
+        f"Scenes whose top grasp failed ({labels_name(r)}): "
+        + ", ".join(r["top_grasp"]["wrong_scenes"]) + ".",
+    ]
+    if ref:
+        lines += [
+            f"With {labels_name(ref)}: " + ", ".join(ref["top_grasp"]["wrong_scenes"]) + ".",
+            "Under their real weight a pan (1–2.5 kg) or a full-size pot held by its handle or",
+            "rim turns in the pads and drags on the table although the handle looks as graspable",
+            "as a glass's body. With either labels, light bowls are pushed away by a pad that",
+            "lands on their rim.",
+        ]
+    lines += [
         "",
         "Our γ is not comparable with the paper's: it depends on the feature units (ours: DI and",
         "DGI pixels concatenated, depth from the volume's back face at 25 units per metre, −1 for",
         "an empty pixel). Our A is negative because our decision value grows with success; the",
         "paper's sign convention is the opposite.",
         "",
-        "| kind of grasp | n | share that held | cross-validated accuracy |",
-        "|---|---|---|---|",
+        "| kind of grasp | n | share that held | cross-validated accuracy |"
+        + (" share that held, real masses | cross-validated, real masses |" if ref else ""),
+        "|---|---|---|---|" + ("---|---|" if ref else ""),
     ]
     for k, v in r["per_kind"].items():
+        extra = ""
+        if ref and k in ref["per_kind"]:
+            w = ref["per_kind"][k]
+            extra = f" {100 * w['positive_rate']:.1f} % | {100 * w['cv_accuracy']:.1f} % |"
         lines.append(f"| {k} | {v['n']} | {100 * v['positive_rate']:.1f} % | "
-                     f"{100 * v['cv_accuracy']:.1f} % |")
-    lines += ["", "| category | accuracy on unseen objects |", "|---|---|"]
+                     f"{100 * v['cv_accuracy']:.1f} % |" + extra)
+    lines += ["", "| category | accuracy on unseen objects |"
+              + (" same, real masses |" if ref else ""),
+              "|---|---|" + ("---|" if ref else "")]
     for c, a in r["objectwise_accuracy_per_category"].items():
-        lines.append(f"| {c} | {100 * a:.1f} % |")
+        extra = (f" {100 * ref['objectwise_accuracy_per_category'][c]:.1f} % |"
+                 if ref and c in ref["objectwise_accuracy_per_category"] else "")
+        lines.append(f"| {c} | {100 * a:.1f} % |" + extra)
     lines += variants_markdown(r.get("variants"))
-    lines += nonlocal_markdown(r)
+    lines += nonlocal_markdown(ref or r, labels_name(ref or r))
     lines += mass_free_markdown(r)
+    lines += full_information_markdown(r.get("variants"))
     lines += repeatability_markdown(r.get("label_repeatability"))
     lines += gentle_markdown(r.get("label_repeatability"), r.get("label_repeatability_gentle"))
+    mass_free = (r.get("variants") or {}).get("mass_free_labels")
     lines += [
         "",
-        "Regenerate (data, model and these tables, then the repeatability study and this page):",
+        "Regenerate (data, the variants, the model and these tables, then the repeatability "
+        "study and this page):",
         "",
         "```",
         "nice -n 10 .venv/bin/python tools/collect_grasps.py --out data/dgi/grasps.jsonl "
         "--workers 1 --summary docs/results/dgi_dataset_summary.json",
-        "nice -n 10 .venv/bin/python tools/dgi_variants.py --data data/dgi/grasps.jsonl",
         *([f"nice -n 10 .venv/bin/python tools/collect_grasps.py --object-mass "
-           f"{r['variants']['mass_free_labels']['mass_kg']:g} --workers 2 "
-           "--out data/dgi/grasps_light.jsonl",
-           "nice -n 10 .venv/bin/python tools/dgi_variants.py --data data/dgi/grasps.jsonl "
-           "--mass-free data/dgi/grasps_light.jsonl --merge"]
-          if (r.get("variants") or {}).get("mass_free_labels") else []),
+           f"{mass_free['mass_kg']:g} --workers 2 --out data/dgi/grasps_light.jsonl "
+           "--summary docs/results/dgi_dataset_summary_light.json"] if mass_free else []),
+        *(r.get("variants") or {}).get("commands", []),
         r["command"],
+        *([ref["command"]] if ref else []),
         (r.get("label_repeatability") or {}).get(
             "command", "nice -n 10 .venv/bin/python tools/label_noise.py "
             "--results docs/results/dgi.json"),
@@ -376,22 +489,41 @@ def markdown(r: dict) -> str:
     return "\n".join(lines)
 
 
-def summary_markdown(r: dict) -> list[str]:
+def summary_markdown(r: dict, ref: dict | None = None) -> list[str]:
     """The goals (issue 6: cross-validated ≥ 90 %, top grasp ≥ 93 %) against what bounds them."""
+
+    def reached(x):
+        return (f"{100 * x['cv_accuracy']:.1f} % "
+                f"({'met' if x['cv_accuracy'] >= 0.90 else 'not met'}) and "
+                f"{100 * x['top_grasp_accuracy']:.1f} % "
+                f"({'met' if x['top_grasp_accuracy'] >= 0.93 else 'not met'}; unseen objects, "
+                f"{100 * x['top_grasp_pregrasp_accuracy']:.1f} % among the part-box pre-grasps "
+                "the pipeline scores)")
+
     lines = ["## Against the goals", "",
-             f"Goals: cross-validated accuracy ≥ 90 %, top-grasp accuracy ≥ 93 %. Reached: "
-             f"{100 * r['cv_accuracy']:.1f} % and {100 * r['top_grasp_accuracy']:.1f} % (unseen "
-             f"objects; {100 * r['top_grasp_pregrasp_accuracy']:.1f} % among the part-box "
-             "pre-grasps the pipeline scores)."]
+             "Goals: cross-validated accuracy ≥ 90 %, top-grasp accuracy ≥ 93 %. Reached by the "
+             f"shipped model ({labels_name(r)}): {reached(r)}."
+             + (f" With {labels_name(ref)}: {reached(ref)}." if ref else "")]
+    full = ((r.get("variants") or {}).get("full_information") or {}).get(
+        Path(r.get("data", "")).stem)
+    if full:
+        lines += [
+            f"- Not the feature: gradient-boosted trees that know the scene (object and resting "
+            f"pose) and the grasp's exact pose besides the DGI reach "
+            f"{100 * full['dgi_scene_and_pose']:.1f} % cross-validated on the shipped labels "
+            f"(the DGI alone {100 * full['dgi']:.1f} %): with about 70 grasps per scene the "
+            "labels' dependence on the pose is finer than the data can teach, whatever the "
+            "feature (section \"What the data can teach\")."]
     rep = r.get("label_repeatability")
     if rep:
         lo, hi = rep["accuracy_ceiling_interval"]
         lines += [
-            f"- Label noise: nudged by {rep['nudge_mm']:g} mm / {rep['nudge_deg']:g}°, a grasp's "
+            "- Label noise (measured on the real-mass labels): nudged by "
+            f"{rep['nudge_mm']:g} mm / {rep['nudge_deg']:g}°, a grasp's "
             f"label repeats {100 * rep['nudged_agreement']:.1f} % of the time (the same pose: "
             f"{100 * rep['exact_repeat_rate']:.1f} %), so no classifier whose input cannot tell "
             "such a nudge apart (a quarter of the cloud's 4 mm spacing) can exceed "
-            f"{100 * lo:.0f}–{100 * hi:.0f} % on these labels (section \"Label "
+            f"{100 * lo:.0f}–{100 * hi:.0f} % on those labels (section \"Label "
             "repeatability\")."]
     gentle = r.get("label_repeatability_gentle")
     if rep and gentle:
@@ -403,40 +535,42 @@ def summary_markdown(r: dict) -> list[str]:
             f"{h.get('n', '?')} failures that the finger-gap rule rejects (pot rims, wide "
             "bowls), no more either: the protocol is not what holds the accuracy down, so the "
             "data were not collected again."]
-    n = r.get("nonlocal_factors")
+    n = (ref or r).get("nonlocal_factors")
     if n:
         s, o = n["stratified"], n["objectwise"]
         lines += [
-            f"- Not local shape: which object it is explains {100 * s['object_majority']:.1f} % "
-            f"alone, mass and category {100 * o['mass_category']:.1f} % on unseen objects; the "
+            f"- Not local shape ({labels_name(ref or r)}): which object it is explains "
+            f"{100 * s['object_majority']:.1f} % alone, mass and category {100 * o['mass_category']:.1f} % on unseen objects; the "
             f"DGI with mass and category reaches {100 * s['dgi_mass_category']:.1f} % "
             f"(unseen objects {100 * o['dgi_mass_category']:.1f} %), with gravity's direction "
             f"and the centroid offset {100 * s['dgi_gravity_centroid']:.1f} % "
             f"({100 * o['dgi_gravity_centroid']:.1f} %): the gap to the ceiling is physics that"
             " neither a 7 mm depth image nor these summaries capture (section \"What local "
             "shape cannot know\")."]
-    m = (r.get("variants") or {}).get("mass_free_labels")
-    if m:
+    if ref:
         lines += [
-            f"- The object's weight: with every object at {m['mass_kg']:g} kg the same grasps' "
-            f"labels give {100 * m['cv_accuracy']:.1f} % cross-validated and "
-            f"{100 * m['top_grasp_accuracy']:.1f} % top grasp on unseen objects: the weight "
-            "holds the top-grasp figure down, not the cross-validated one (section \"Labels "
+            f"- The object's weight holds the top-grasp figure down, not the cross-validated "
+            f"one: {100 * ref['top_grasp_accuracy']:.1f} % → "
+            f"{100 * r['top_grasp_accuracy']:.1f} % top grasp, "
+            f"{100 * ref['cv_accuracy']:.1f} % → {100 * r['cv_accuracy']:.1f} % "
+            "cross-validated, from the real masses to the shipped labels (section \"Labels "
             "without the object's weight\")."]
     v = r.get("variants")
     if v:
         shipped = v["variants"].get("shipped", {}).get("cv_accuracy")
         best = v["variants"][v["best_by_cv_accuracy"]]
-        se = np.sqrt(r["cv_accuracy"] * (1 - r["cv_accuracy"]) / r["n_grasps"])
+        base = ref or r  # the variants run on the real-mass labels
+        se = np.sqrt(base["cv_accuracy"] * (1 - base["cv_accuracy"]) / base["n_grasps"])
         verdict = ""
         if shipped is not None:
             verdict = (f" against the shipped feature's {100 * shipped:.2f} %, "
                        + ("within two standard errors of an accuracy over "
-                          f"{r['n_grasps']} grasps ({100 * se:.1f} points each): the shipped "
+                          f"{base['n_grasps']} grasps ({100 * se:.1f} points each): the shipped "
                           "feature stays." if best["cv_accuracy"] - shipped < 2 * se
                           else "beyond two standard errors."))
         lines += [
-            f"- Feature and SVM variants (section \"Feature and SVM variants\"): the best, "
+            f"- Feature and SVM variants (section \"Feature and SVM variants\", real-mass "
+            "labels): the best, "
             f"{v['best_by_cv_accuracy']}, reaches {100 * best['cv_accuracy']:.2f} %" + verdict]
         curve = v.get("learning_curve")
         if curve:
@@ -455,6 +589,8 @@ def variants_markdown(v: dict | None) -> list[str]:
     lines = [
         "",
         "## Feature and SVM variants",
+        "",
+        "On the real-mass labels (tools/dgi_variants.py --data data/dgi/grasps.jsonl).",
         "",
         "The feature against the paper (section V-A): DI(u, v) is the smallest depth in each",
         "7 mm cell, −1 where the cell is empty (eq. 3); the DGI is the magnitude of central",
@@ -491,7 +627,7 @@ def variants_markdown(v: dict | None) -> list[str]:
     return lines
 
 
-def nonlocal_markdown(r: dict) -> list[str]:
+def nonlocal_markdown(r: dict, labels: str) -> list[str]:
     n = r["nonlocal_factors"]
     s, o = n["stratified"], n["objectwise"]
     nested = ", ".join(f"γ {p['gamma']:g} / C {p['C']:g}" for p in r["objectwise_nested_params"])
@@ -507,7 +643,8 @@ def nonlocal_markdown(r: dict) -> list[str]:
         "The label depends on more than the shape between the pads: on the object's mass and",
         "where it lies (a handle that holds a spatula does not hold a full pan), which the DGI",
         "cannot see. Accuracy of classifiers that see only the object, and of the DGI with it",
-        "(same folds as above; the logistic regression and the SVM with the DGI's γ and C):",
+        f"(labels with {labels}; same folds as above; the logistic regression and the SVM with",
+        "the DGI's γ and C):",
         "",
         "| classifier | folds not by object | folds by object (unseen objects) | top grasp "
         "(unseen) |",
@@ -518,7 +655,7 @@ def nonlocal_markdown(r: dict) -> list[str]:
         "| – | – |",
         f"| mass + category (logistic regression) | {100 * s['mass_category']:.1f} % | "
         f"{100 * o['mass_category']:.1f} % | – |",
-        f"| DGI (the shipped model) | {100 * r['cv_accuracy']:.1f} % | "
+        f"| DGI (the shipped feature and SVM) | {100 * r['cv_accuracy']:.1f} % | "
         f"{100 * r['objectwise_cv_accuracy']:.1f} % | {100 * r['top_grasp_accuracy']:.1f} % |",
         row("DGI + mass + category", "dgi_mass_category"),
         row("DGI + gravity's direction in the gripper frame", "dgi_gravity"),
@@ -528,6 +665,41 @@ def nonlocal_markdown(r: dict) -> list[str]:
         "logic's P(part | task) carries what is known about the object). In the folds by object,",
         f"γ and C were chosen on each fold's training objects alone ({nested}).",
     ]
+
+
+def full_information_markdown(v: dict | None) -> list[str]:
+    """tools/dgi_variants.py --full-information: what the data can teach, on both labels."""
+    full = (v or {}).get("full_information")
+    if not full:
+        return []
+    names = {"grasps": "real masses", "grasps_light": "every object light (shipped)"}
+    lines = [
+        "",
+        "### What the data can teach",
+        "",
+        "A classifier that knows more than any local feature can: the scene (object and resting",
+        "pose, one-hot) and the grasp's exact pose relative to the cloud's centroid, which",
+        "together fix the label up to its noise. Gradient-boosted trees "
+        f"({next(iter(full.values()))['classifier']}), 4-fold stratified cross-validation:",
+        "",
+        "| labels | DGI | scene + grasp pose | DGI + scene + grasp pose |",
+        "|---|---|---|---|",
+    ]
+    for stem, e in full.items():
+        lines.append(f"| {names.get(stem, stem)} ({e['n_grasps']} grasps) | "
+                     f"{100 * e['dgi']:.1f} % | {100 * e['scene_and_pose']:.1f} % | "
+                     f"{100 * e['dgi_scene_and_pose']:.1f} % |")
+    lines += [
+        "",
+        "Knowing exactly where the gripper is on which object gains 2–3 points over the DGI:",
+        "a scene has about 70 executed grasps spread over positions 1 cm and angles 11° apart",
+        "(and the random ones anywhere on the object), while the label turns over within a",
+        "millimetre or a degree at 3–4 % of grasps (section \"Label repeatability\") and with",
+        "the finger-pad contact over a few millimetres: the data sample the label too coarsely",
+        "for any classifier to reach 90 % on them, whatever feature it is given. The paper's",
+        "rectangles were hand-labelled where the answer is plain, not sampled at random.",
+    ]
+    return lines
 
 
 def mass_free_markdown(r: dict) -> list[str]:
@@ -561,8 +733,12 @@ def mass_free_markdown(r: dict) -> list[str]:
         "",
         "The object's weight is what holds the top-grasp figure down (under their real weight",
         "the pans' and pots' local grasps fail, whatever their shape), not the cross-validated",
-        "accuracy. The shipped model keeps the real masses: the pipeline executes grasps on",
-        "objects of their real weight.",
+        "accuracy. Judged by the real-mass labels, the model trained on the light ones is as",
+        "good as the one trained on them, so the shipped model learns from the light labels:",
+        "P(grasp | local shape) as the paper means it, whether the shape between the pads affords",
+        "a grasp. The weight is left to the planner (within a part it tries first the grasps",
+        "with the shortest lever of the object's weight about the closing axis, and refuses",
+        "levers over 12 cm) and to the logic (which part, for which task).",
     ]
 
 

@@ -8,6 +8,7 @@ from tg_drake.grasping.dataset import (
     SamplingConfig,
     scene_cloud,
     scene_grasps,
+    training_order,
     training_set,
 )
 from tg_drake.grasping.dgi import PAD_CENTER_Y, DgiConfig, dgi_features
@@ -59,3 +60,24 @@ def test_training_set_computes_features_of_ok_records_only(cup):
     assert set(data.scenes) == {"cup_01/sideways"}
     np.testing.assert_array_equal(data.X_WG, scene.X_WG[:6])
     np.testing.assert_allclose(data.centroids, np.repeat(p_W.mean(axis=0)[None], 6, axis=0))
+
+
+def test_training_order_lines_records_up_with_the_training_rows(cup):
+    # Two scenes, the later one in sorted order first in the file, a failed run between: the
+    # rows come scene by scene in sorted order, each scene's grasps as in the file.
+    rows = []
+    for pose in ("upright", "sideways"):
+        scene = scene_grasps(cup, pose, seed=0)
+        rows += [{"job": f"cup_01/{pose}/0", "index": i, "object": "cup_01", "pose": pose,
+                  "kind": str(scene.kinds[i]), "part": int(scene.parts[i]),
+                  "X_WG": scene.X_WG[i].ravel().tolist(), "status": "ok",
+                  "success": (i + len(rows)) % 3 == 0} for i in range(3)]
+    rows.insert(2, {"job": "cup_01/upright/0", "index": 9, "object": "cup_01",
+                    "pose": "upright", "status": "sim_error", "reason": "solver"})
+    ordered = training_order(rows)
+    assert [(r["pose"], r["index"]) for r in ordered] == [
+        ("sideways", 0), ("sideways", 1), ("sideways", 2),
+        ("upright", 0), ("upright", 1), ("upright", 2)]
+    data = training_set(rows, seed=0)
+    np.testing.assert_array_equal(data.y, [int(r["success"]) for r in ordered])
+    np.testing.assert_array_equal(data.X_WG.reshape(-1, 16), [r["X_WG"] for r in ordered])

@@ -492,7 +492,7 @@ def test_within_a_part_the_grasp_nearer_the_weight_is_tried_first():
 
 
 def test_an_object_past_both_pads_is_refused_one_past_a_single_pad_is_not():
-    from tg_drake.planning.planner import _extent_along_closing
+    from tg_drake.planning.planner import _extent_along_closing, _refusal
 
     config = PlannerConfig()
     half = (config.open_width - config.release_gap) / 2
@@ -506,12 +506,25 @@ def test_an_object_past_both_pads_is_refused_one_past_a_single_pad_is_not():
     lo, hi = _extent_along_closing(can, X, config.release_band)
     assert (lo, hi) == pytest.approx((-0.0565, 0.0565), abs=1e-9)
     assert -lo > half and hi > half
+    # A shorter one, 102 mm (can_03 as perceived), its middle part a 34 mm band that fits the
+    # opening: 4 mm a side at the release kept it wedged in simulation.
+    short = box_object([0.7, 0.0, 0.03], [0.034, 0.055, 0.055], parts=("middle",))
+    short.p_W = np.array([[0.7 + x, 0.0275 * np.cos(a), 0.03 + 0.0275 * np.sin(a)]
+                          for x in np.linspace(-0.051, 0.051, 27) for a in t])
+    assert "could not let go" in _refusal(short, "middle", X, None, config)
     # A cup's handle reaching past one pad only: the fingers open clear of the other side.
     cup = box_object([0.7, 0.0, 0.03], [0.105, 0.075, 0.06], parts=("middle",))
     cup.p_W = can.p_W[np.abs(can.p_W[:, 0] - 0.7) <= 0.0375] + [0.0, 0.0, 0.0]
     cup.p_W = np.vstack([cup.p_W, [[0.7 + 0.0675, 0.0, 0.03]]])  # the handle's far end
     lo, hi = _extent_along_closing(cup, X, config.release_band)
     assert hi > half and not -lo > half
+    # A lying cup taken across its body, 46 mm on the near side and its handle out to 73 mm
+    # on the far one (cup_04 as perceived): let go in simulation.
+    body = np.array([[0.7 + x, 0.0275 * np.cos(a), 0.03 + 0.0275 * np.sin(a)]
+                     for x in np.linspace(-0.046, 0.046, 24) for a in t])
+    cup.p_W = np.vstack([body, [[0.7 + x, 0.0, 0.03] for x in np.linspace(0.046, 0.073, 8)]])
+    lo, hi = _extent_along_closing(cup, X, config.release_band)
+    assert -lo < half < hi
 
 
 def test_a_grasp_far_from_the_weight_across_the_lever_is_refused():

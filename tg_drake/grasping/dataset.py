@@ -141,15 +141,27 @@ class TrainingSet:
     centroids: np.ndarray | None = None  # (n, 3) centroid of the scene's cloud in the world [m].
 
 
+def _by_scene(records: list[dict]) -> list[tuple[tuple[str, str], list[dict]]]:
+    by_scene: dict[tuple[str, str], list[dict]] = {}
+    for r in records:
+        if r.get("status") == "ok":
+            by_scene.setdefault((r["object"], r["pose"]), []).append(r)
+    return sorted(by_scene.items())
+
+
+def training_order(records: list[dict]) -> list[dict]:
+    """The records with status "ok" in the order of `training_set`'s rows: scenes (object, pose)
+    sorted, and within a scene as in `records` — to line other data of the same grasps up with
+    the features (the same jobs executed with another object mass, say)."""
+    return [r for _, rows in _by_scene(records) for r in rows]
+
+
 def training_set(records: list[dict], *, seed: int, config: DgiConfig = DgiConfig(),
                  sampling: SamplingConfig = SamplingConfig()) -> TrainingSet:
-    """Features and labels of the executed grasps with status "ok" (see collect_grasps.py)."""
-    ok = [r for r in records if r.get("status") == "ok"]
-    by_scene: dict[tuple[str, str], list[dict]] = {}
-    for r in ok:
-        by_scene.setdefault((r["object"], r["pose"]), []).append(r)
+    """Features and labels of the executed grasps with status "ok" (see collect_grasps.py), in
+    the order of `training_order`."""
     X, y, objs, scenes, kinds, parts, poses, centroids = [], [], [], [], [], [], [], []
-    for (object_id, pose), rows in sorted(by_scene.items()):
+    for (object_id, pose), rows in _by_scene(records):
         p_W, _, _ = scene_cloud(get_object(object_id), pose, seed=seed, config=sampling)
         X_WG = np.array([r["X_WG"] for r in rows], dtype=float).reshape(-1, 4, 4)
         X.append(dgi_features(p_W, X_WG, config))

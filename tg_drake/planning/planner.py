@@ -73,8 +73,13 @@ class PlannerConfig:
     # slowly (open → 0 over close_duration) so that they meet a light object gently; and back
     # closed_width → 0 at release, before opening over open_duration.
     width_margin: float = 0.01  # [m] a part must be this much narrower than the opening.
-    release_gap: float = 0.005  # [m] an object reaching past both open pads, less this gap
-    # (within `release_band` of the grasp point across the pads), could not be let go.
+    release_gap: float = 0.013  # [m] an object reaching past both open pads, less this gap
+    # (within `release_band` of the grasp point across the pads), could not be let go. Measured
+    # (perceived half extents, S_GRASP): a can or glass lying down, taken along its axis, 51.1
+    # and 51.6 mm a side (4 mm from the opened pads), stayed wedged (can_03, glass_01 sideways,
+    # once the DGI learned from light-object labels); a lying cup across its body, 45.1-45.9 mm
+    # on the near side, was let go (cup_04). 13 mm sets the limit at 48.5 mm, halfway; 5 mm
+    # allowed the wedged ones and 20 mm refused the cup's grasps that held.
     release_band: float = 0.03  # [m]
     close_duration: float = 0.8  # [s] opening → closed command ramp (scripted.py's timing).
     settle_duration: float = 0.4  # [s] hold after closing, before lifting.
