@@ -7,7 +7,10 @@ paper's criterion; C = 1, which every search so far chose) and with it are repor
 accuracy, the accuracy on unseen objects (4 folds by object) and the top-grasp accuracy on
 unseen objects. The choice among variants is made on the
 stratified accuracy only, never on the unseen-object figures. Results go to
-docs/results/dgi_variants.json; tools/train_dgi.py shows them in dgi.md.
+docs/results/dgi_variants.json; tools/train_dgi.py shows them in dgi.md. Besides the variants:
+--learning-curve, --mass-free (labels of the same grasps with every object light) and
+--full-information (what a classifier told the scene and the grasp's exact pose reaches, on
+--data's labels: a bound on what the data can teach).
 
     nice -n 10 .venv/bin/python tools/dgi_variants.py --data data/dgi/grasps.jsonl
 """
