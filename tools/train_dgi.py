@@ -200,6 +200,9 @@ def main(argv=None) -> int:
     parser.add_argument("--no-model", action="store_true",
                         help="evaluate only; leave the shipped model file alone")
     args = parser.parse_args(argv)
+    for name, path in (("--data", args.data), ("--judge-data", args.judge_data)):
+        if path is not None and not args.markdown_only and not path.is_file():
+            parser.error(f"{name} {path}: no such file (collect it with tools/collect_grasps.py)")
     if args.markdown_only:
         write_markdown(args.results, json.loads((args.results / "dgi.json").read_text()))
         return 0
