@@ -49,6 +49,19 @@ def make_jobs(objects, *, seed: int, batch: int, sampling: SamplingConfig,
     return jobs, through_table
 
 
+def recorded_masses(out: Path) -> set[float]:
+    """The --object-mass values (0.0: the objects' own) the grasps already in `out` ran with."""
+    if not out.exists():
+        return set()
+    masses = set()
+    for line in out.read_text().splitlines():
+        try:
+            masses.add(float(json.loads(line).get("object_mass", 0.0)))
+        except (json.JSONDecodeError, AttributeError):
+            continue  # a torn last line
+    return masses
+
+
 def summarise(records: list[dict], *, seed: int, through_table: int) -> dict:
     """Counts per object and label, failures by reason, and the time per grasp."""
     per_object: dict[str, Counter] = defaultdict(Counter)
@@ -104,6 +117,11 @@ def main(argv=None) -> int:
     if args.object_mass < 0:
         parser.error(f"--object-mass must be ≥ 0 kg, got {args.object_mass}")
     episode = EpisodeConfig(object_mass=args.object_mass)
+    mixed = recorded_masses(args.out) - {args.object_mass}
+    if mixed:  # a rerun skips the finished jobs: their labels would be of another mass
+        parser.error(f"{args.out} holds grasps executed with --object-mass "
+                     f"{', '.join(f'{m:g}' for m in sorted(mixed))} (0: the objects' own masses), "
+                     f"not {args.object_mass:g}: choose another --out")
     jobs, through_table = make_jobs(objects, seed=args.seed, batch=args.batch,
                                     sampling=SamplingConfig(), episode=episode)
     n_grasps = sum(len(j.payload["grasps"]) for j in jobs)

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from tg_drake.grasping.dgi import FINGERTIP_Y, PAD_CENTER_Y
-from tg_drake.grasping.episode import EpisodeConfig, GraspWorld, scripted_targets
+from tg_drake.grasping.episode import (EpisodeConfig, GraspWorld, run_grasp_batch,
+                                       scripted_targets)
 
 CYLINDER_SDF = """<?xml version="1.0"?>
 <sdf version="1.9" xmlns:drake="http://drake.mit.edu">
@@ -137,3 +138,17 @@ def test_object_mass_scales_the_inertia_and_keeps_the_centre_of_mass(tmp_path):
     result = world.run(X_WO, top_down([0, 0, HEIGHT + 0.01]))  # the context's mass persists
     assert result["status"] == "ok" and result["success"]
     assert world.object_body.CalcSpatialInertiaInBodyFrame(context).get_mass() == pytest.approx(0.1)
+
+
+def test_a_batch_records_the_object_mass_it_ran_with(tmp_path):
+    # collect_grasps.py refuses to add grasps of one mass to a file of another: the records say.
+    path = tmp_path / "cylinder.sdf"
+    path.write_text(CYLINDER_SDF)
+    grasp = {"index": 0, "kind": "box", "part": 1,
+             "X_WG": top_down([0, 0, HEIGHT + 0.01]).ravel().tolist()}
+    payload = {"object_sdf": str(path), "object": "cylinder", "pose": "upright",
+               "X_WO": X_WO.ravel().tolist(), "grasps": [grasp]}
+    light, = run_grasp_batch({**payload, "config": {"object_mass": 0.1}})
+    own, = run_grasp_batch({**payload, "config": {}})
+    assert light["object_mass"] == 0.1 and "object_mass" not in own
+    assert light["status"] == own["status"] == "ok" and light["index"] == 0

@@ -346,8 +346,9 @@ def run_grasp_batch(payload: dict) -> list[dict]:
 
     `payload`: {"object_sdf", "object", "pose", "X_WO" (16 floats), "config" (EpisodeConfig
     fields), "grasps": [{"index", "kind", "part", "X_WG" (16 floats)}, ...]}. Returns one record per
-    grasp: the grasp's fields and the episode's result. The world of the last object is kept for
-    the next batch of this worker process.
+    grasp: the grasp's fields and the episode's result, and "object_mass" when the episode set one
+    (`EpisodeConfig.object_mass`). The world of the last object is kept for the next batch of this
+    worker process.
     """
     config = EpisodeConfig(**payload.get("config", {}))
     key = (payload["object_sdf"], repr(config))
@@ -356,8 +357,10 @@ def run_grasp_batch(payload: dict) -> list[dict]:
         _WORLDS[key] = GraspWorld(payload["object_sdf"], config)
     world = _WORLDS[key]
     X_WO = np.array(payload["X_WO"], dtype=float).reshape(4, 4)
+    mass = {"object_mass": config.object_mass} if config.object_mass > 0 else {}
     records = []
     for grasp in payload["grasps"]:
         result = world.run(X_WO, np.array(grasp["X_WG"], dtype=float).reshape(4, 4))
-        records.append({"object": payload["object"], "pose": payload["pose"], **grasp, **result})
+        records.append({"object": payload["object"], "pose": payload["pose"], **grasp, **result,
+                        **mass})
     return records
