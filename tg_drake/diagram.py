@@ -30,7 +30,7 @@ from pydrake.systems.primitives import ConstantValueSource
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.objects import box_centre
-from tg_drake.scenario import PipelineConfig, Scenario
+from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario
 from tg_drake.station import Station, add_station, placement_pose
 from tg_drake.targeting import select_target
 from tg_drake.types import SceneDescription
@@ -78,8 +78,7 @@ class Pipeline:
 def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
                  config: PipelineConfig | None = None) -> Pipeline:
     """Adds the station and every stage of `scenario` to `builder`, wired as in the module doc."""
-    from tg_drake.kernels.database import KernelPriorConfig
-    from tg_drake.logic.engine import LogicQueryConfig
+    from tg_drake.grasping.model import load_model
     from tg_drake.systems.dgi_system import DgiScoringSystem
     from tg_drake.systems.grasp_planner import GraspPlanner
     from tg_drake.systems.kernel_prior_system import KernelPriorSystem
@@ -92,17 +91,18 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     X_WO_target = placement_pose(scenario, target_placement)
 
     # Perception: the rendered depth image of one camera, or the library's ground truth.
-    if config.perception == "depth":
+    if isinstance(config.perception, DepthPerception):
         from tg_drake.systems.perception_system import PerceptionSystem
 
-        if config.camera not in station.cameras:
-            raise unknown_name("camera", config.camera, list(station.cameras),
-                               error=ScenarioError, field="pipeline.camera")
-        perception = builder.AddNamedSystem(
-            "perception", PerceptionSystem(camera_info=station.cameras[config.camera].info))
-        builder.Connect(station.outputs[f"{config.camera}.depth_image"],
+        camera = config.perception.camera
+        if camera not in station.cameras:
+            raise unknown_name("camera", camera, list(station.cameras),
+                               error=ScenarioError, field="pipeline.perception.camera")
+        perception = builder.AddNamedSystem("perception", PerceptionSystem(
+            camera_info=station.cameras[camera].info, config=config.perception.config))
+        builder.Connect(station.outputs[f"{camera}.depth_image"],
                         perception.GetInputPort("depth_image"))
-        builder.Connect(station.outputs[f"{config.camera}.camera_pose"],
+        builder.Connect(station.outputs[f"{camera}.camera_pose"],
                         perception.GetInputPort("camera_pose"))
     else:
         from tg_drake.systems.perception_system import GroundTruthPerception
@@ -112,7 +112,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
             [placement_pose(scenario, p) for p in scenario.objects],
             X_WT=scenario.X_WT.GetDeterministicValue(),
             poses=[p.pose for p in scenario.objects],
-            containments=[p.containment for p in scenario.objects]))
+            containments=[p.containment for p in scenario.objects],
+            spacing=config.perception.spacing, seed=scenario.random_seed))
     # The user points at the target's middle (its box centre; its frame's origin is at its base).
     target = builder.AddNamedSystem("target", TargetSelector(
         X_WO_target.multiply(box_centre(target_placement.id))))
@@ -120,19 +121,17 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     scene = target.get_output_port()
 
     # Category prior, logic, grasp scoring.
-    prior = builder.AddNamedSystem("kernel_prior", KernelPriorSystem(KernelPriorConfig(
-        clouds="ground_truth" if config.perception == "ground_truth" else "perceived")))
+    prior = builder.AddNamedSystem("kernel_prior", KernelPriorSystem(config.prior_config()))
     builder.Connect(scene, prior.GetInputPort("scene_description"))
-    logic = builder.AddNamedSystem("logic", LogicQuerySystem(LogicQueryConfig(
-        category=config.category_theory, grasp=config.grasp_theory,
-        use_prior=config.use_prior, prior_floor=config.prior_floor)))
+    logic = builder.AddNamedSystem("logic", LogicQuerySystem(config.logic))
     task = builder.AddNamedSystem("task", ConstantValueSource(
         AbstractValue.Make(scenario.task.task)))
     builder.Connect(scene, logic.GetInputPort("scene_description"))
     builder.Connect(prior.GetOutputPort("category_prior"), logic.GetInputPort("category_prior"))
     builder.Connect(task.get_output_port(), logic.GetInputPort("task"))
-    scoring = builder.AddNamedSystem(
-        "dgi_scoring", DgiScoringSystem(selection=config.grasp_selection))
+    scoring = builder.AddNamedSystem("dgi_scoring", DgiScoringSystem(
+        load_model(config.scoring.model) if config.scoring.model else None,
+        selection=config.selection, part=getattr(config.scoring, "part", None)))
     builder.Connect(scene, scoring.GetInputPort("scene_description"))
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     scoring.GetInputPort("grasp_semantics"))
@@ -141,8 +140,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     X_WT = scenario.X_WT.GetDeterministicValue()
     place_xy_W = (X_WT @ np.array([*scenario.task.place_xy, 0.0, 1.0]))[:2]
     planner = builder.AddNamedSystem("planner", GraspPlanner(
-        place_xy=place_xy_W, start_time=config.planning_start,
-        max_requeries=config.max_requeries, scenario=scenario, grasp_part=config.grasp_part))
+        place_xy=place_xy_W, start_time=config.planning_start, config=config.planner,
+        max_requeries=config.max_requeries, scenario=scenario))
     builder.Connect(scene, planner.GetInputPort("scene_description"))
     builder.Connect(scoring.GetOutputPort("ranked_grasps"), planner.GetInputPort("ranked_grasps"))
     builder.Connect(station.outputs["iiwa.state"], planner.GetInputPort("iiwa.state"))

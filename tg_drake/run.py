@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tg_drake.logic.theory import VARIANTS as THEORY_VARIANTS
 from tg_drake.errors import (GraspingError, KernelError, PerceptionError, PlanningError,
                              RuleError, SimulationError, TgDrakeError)
 
@@ -56,9 +57,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--meshcat", action="store_true",
                         help="serve Drake's Meshcat viewer on localhost and replay the run there")
     parser.add_argument("--no-images", action="store_true", help="skip the PNG pictures")
-    parser.add_argument("--theory", choices=("specific", "general", "learned"), default=None,
+    parser.add_argument("--theory", choices=THEORY_VARIANTS, default=None,
                         help="both models of this theory variant, overriding the scenario's "
-                        "pipeline.category_theory and grasp_theory")
+                        "pipeline.logic.category and pipeline.logic.grasp")
 
 
 def _distribution(d: dict) -> dict:
@@ -104,10 +105,11 @@ def run_scenario(scenario, *, scenario_path: str = "", meshcat=None, images_dir:
         timings[name] = time.perf_counter() - t0
         return value
 
-    camera = pipeline.config.camera
+    # The camera perception looks through (the first camera for ground-truth perception).
+    camera = getattr(pipeline.config.perception, "camera", next(iter(station.cameras), ""))
     outcome = None
     try:
-        if pipeline.config.perception == "depth":
+        if not pipeline.config.ground_truth_perception:
             timed("render", station.outputs[f"{camera}.depth_image"])
         scene = timed("perception", pipeline.ports["scene_description"])
         result["perception"] = _perception_json(scene)
@@ -374,7 +376,7 @@ def main(args) -> int:
 
     scenario = load_scenario(args.scenario, scenario_name=args.name)
     if getattr(args, "theory", None):
-        scenario.pipeline.category_theory = scenario.pipeline.grasp_theory = args.theory
+        scenario.pipeline.logic.category = scenario.pipeline.logic.grasp = args.theory
     out = args.out or Path("out") / (args.name or args.scenario.stem)
     out.mkdir(parents=True, exist_ok=True)
     meshcat = None

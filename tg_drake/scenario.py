@@ -29,7 +29,14 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.sensors import CameraConfig
 
-from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.errors import RuleError, ScenarioError, unknown_name
+from tg_drake.kernels.database import SOURCES as KERNEL_SOURCES
+from tg_drake.kernels.database import KernelPriorConfig
+from tg_drake.logic.engine import LogicQueryConfig
+from tg_drake.perception.config import PerceptionConfig
+from tg_drake.planning.planner import PlannerConfig
+from tg_drake.robot import IIWA_HOME
+from tg_drake.schema_check import SchemaError, check_document, load_raw
 from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 # Where the table-top frame T sits in the world (its surface at the iiwa base height). Its centre
@@ -41,8 +48,6 @@ X_WT_DEFAULT = RigidTransform([0.75, 0.0, 0.0])
 # direction +y_G along link 7's z axis (robot_facts.md: "mount").
 X_7G = RigidTransform(RollPitchYaw(np.pi / 2, 0, np.pi / 2), [0, 0, 0.114])
 
-# A posture that keeps the arm clear of the camera's view of the table (radians, joints 1–7).
-IIWA_HOME = (0.0, -0.6, 0.0, -1.9, 0.0, 1.0, 0.0)
 
 
 def _transform(X: RigidTransform, base_frame: str | None = None) -> Transform:
@@ -181,46 +186,117 @@ class TaskConfig:
     ground_truth: GroundTruth = field(default_factory=GroundTruth)
 
 
-PERCEPTION_MODES = ("depth", "ground_truth")
-GRASP_SELECTIONS = ("pipeline", "local_only")  # tg_drake.grasping.scoring.rank_grasps
-THEORY_VARIANTS = ("specific", "general", "learned")  # "learned": tools/learn_theory.py
+@dataclass
+class DepthPerception:
+    """Perception of the rendered depth image of one camera (paper III): table plane, objects,
+    symmetry-based completion, pose, parts and pre-grasp hypotheses."""
+
+    camera: str = "camera0"  # which of the scenario's `cameras` perception looks through
+    config: PerceptionConfig = field(default_factory=PerceptionConfig)  # every step's parameters
+
+
+@dataclass
+class GroundTruthPerception:
+    """The object library's labelled surfaces at the true poses, for the synthetic
+    (perfect-perception) evaluation: the paper's S_SYN setting. Never reads the camera."""
+
+    spacing: float = 0.004  # [m] the meshes' surfaces are sampled this far apart
+
+
+PerceptionVariant = typing.Union[DepthPerception, GroundTruthPerception]
+
+
+@dataclass
+class DgiScorer:
+    """score = P(part | task) · P(grasp | local shape): the paper's pipeline (section V)."""
+
+    model: str = ""  # a DGI model file (tools/train_dgi.py writes one); "" = the shipped model
+
+
+@dataclass
+class LocalOnly:
+    """score = P(grasp | local shape) alone, ignoring the logic: the paper's Local baseline."""
+
+    model: str = ""  # as DgiScorer.model
+
+
+@dataclass
+class OnePart:
+    """Only the hypotheses of `part` are scored, by P(grasp | local shape) alone, even where the
+    logic gives that part 0; every other hypothesis scores 0. For collecting grasp outcomes per
+    part (tools/learn_theory.py), so that outcomes exist for parts the logic would not pick."""
+
+    part: str = "middle"  # one of PART_LABELS
+    model: str = ""  # as DgiScorer.model
+
+
+ScoringVariant = typing.Union[DgiScorer, LocalOnly, OnePart]
+
+# The core's name (tg_drake.grasping.scoring.SELECTIONS) of each scoring variant.
+SELECTION_OF_SCORING = {DgiScorer: "pipeline", LocalOnly: "local_only", OnePart: "one_part"}
+
+
+def _pipeline_logic() -> LogicQueryConfig:
+    # The logic sees (1 − floor)·prior + floor/11: a perceived object's kernel prior can miss its
+    # category, and a zero there would make the evidence impossible.
+    return LogicQueryConfig(prior_floor=0.02)
 
 
 @dataclass
 class PipelineConfig:
-    """How the stages are set up. Lives in the scenario's `pipeline` block."""
+    """Every stage's settings. Lives in the scenario's `pipeline` block; alternatives are tagged
+    (`perception: !GroundTruthPerception {}`, `scoring: !LocalOnly {}`)."""
 
-    camera: str = "camera0"  # which camera perception looks through
-    perception: str = "depth"  # "depth": perceive the rendered depth image; "ground_truth":
-    # the object library's labelled surfaces at the true poses (the paper's S_SYN setting)
-    category_theory: str = "specific"  # category model variant: specific | general
-    grasp_theory: str = "specific"  # grasp model variant: specific | general
-    use_prior: bool = True  # the kernel prior feeds the logic (PLM); False: uniform (PLM_uniform)
-    prior_floor: float = 0.02  # the logic sees (1 − floor)·prior + floor/11: a perceived object's
-    # kernel prior can miss its category, and a zero there would make the evidence impossible
+    perception: PerceptionVariant = field(default_factory=DepthPerception)
+    prior: KernelPriorConfig = field(default_factory=KernelPriorConfig)  # kernel category prior
+    logic: LogicQueryConfig = field(default_factory=_pipeline_logic)  # theory variants, prior use
+    scoring: ScoringVariant = field(default_factory=DgiScorer)  # how hypotheses are ranked
+    planner: PlannerConfig = field(default_factory=PlannerConfig)  # the pick-and-place plan
     planning_start: float = 0.05  # [s] simulated time of the first planning event
     max_requeries: int = 3  # re-queries of the logic with collision(Part) evidence
     min_grasp_probability: float = 0.03  # below this P(some part is grasped | observations), the
     # logic is taken to rule grasping out (an upside-down pan: 0.015; the paper's Fig. 1 cup: 0.13)
-    grasp_selection: str = "pipeline"  # how hypotheses are ranked: "pipeline" (P(part | task) ·
-    # P(grasp | local shape)) or "local_only" (P(grasp | local shape) alone, the paper's Local)
-    grasp_part: str | None = None  # only hypotheses of this PART_LABELS part are tried, ranked by
-    # the DGI's P(grasp | shape) alone (the logic may give the part 0): for data collection
 
     def validate(self, where: str = "pipeline") -> None:
-        if self.perception not in PERCEPTION_MODES:
-            raise unknown_name("perception mode", self.perception, PERCEPTION_MODES,
-                               error=ScenarioError, field=f"{where}.perception")
-        for name in ("category_theory", "grasp_theory"):
-            if getattr(self, name) not in THEORY_VARIANTS:
-                raise unknown_name("theory variant", getattr(self, name), THEORY_VARIANTS,
-                                   error=ScenarioError, field=f"{where}.{name}")
-        if self.grasp_selection not in GRASP_SELECTIONS:
-            raise unknown_name("grasp selection", self.grasp_selection, GRASP_SELECTIONS,
-                               error=ScenarioError, field=f"{where}.grasp_selection")
-        if self.grasp_part is not None and self.grasp_part not in PART_LABELS:
-            raise unknown_name("part", self.grasp_part, PART_LABELS, error=ScenarioError,
-                               field=f"{where}.grasp_part")
+        """Checks names the YAML types cannot; raises ScenarioError naming the field."""
+        if isinstance(self.perception, DepthPerception) and not self.perception.camera:
+            raise ScenarioError("perception needs a camera name", field=f"{where}.perception.camera")
+        if isinstance(self.perception, GroundTruthPerception) and not self.perception.spacing > 0:
+            raise ScenarioError(f"spacing must be > 0 [m], got {self.perception.spacing}",
+                                field=f"{where}.perception.spacing")
+        try:
+            self.logic.theory()
+        except RuleError as e:
+            raise ScenarioError(e.message, field=f"{where}.logic.{e.field}") from None
+        if not 0.0 <= self.logic.prior_floor <= 1.0:
+            raise ScenarioError(f"prior_floor must be in [0, 1], got {self.logic.prior_floor}",
+                                field=f"{where}.logic.prior_floor")
+        if self.prior.clouds is not None and self.prior.clouds not in KERNEL_SOURCES:
+            raise unknown_name("cloud source", self.prior.clouds, KERNEL_SOURCES,
+                               error=ScenarioError, field=f"{where}.prior.clouds")
+        if isinstance(self.scoring, OnePart) and self.scoring.part not in PART_LABELS:
+            raise unknown_name("part", self.scoring.part, PART_LABELS, error=ScenarioError,
+                               field=f"{where}.scoring.part")
+        if self.scoring.model and not Path(self.scoring.model).is_file():
+            raise ScenarioError(f"no such DGI model file {self.scoring.model!r}",
+                                field=f"{where}.scoring.model")
+
+    @property
+    def ground_truth_perception(self) -> bool:
+        return isinstance(self.perception, GroundTruthPerception)
+
+    def prior_config(self) -> KernelPriorConfig:
+        """The kernel prior's settings, its query clouds set from the perception variant unless
+        given (ground-truth samplings for ground-truth perception, else perceived clouds)."""
+        if self.prior.clouds is not None:
+            return self.prior
+        return dataclasses.replace(
+            self.prior, clouds="ground_truth" if self.ground_truth_perception else "perceived")
+
+    @property
+    def selection(self) -> str:
+        """The scoring core's name of the scoring variant."""
+        return SELECTION_OF_SCORING[type(self.scoring)]
 
 
 @dataclass
@@ -264,6 +340,8 @@ def load_scenario(filename: "str | Path | None" = None, *, scenario_name: str | 
     where = str(filename) if filename is not None else "<text>"
     if filename is not None and not Path(filename).is_file():
         raise ScenarioError("no such scenario file", file=where)
+    _check_raw(Path(filename).read_text() if filename is not None else None, scenario_name,
+               scenario_text, where)
     try:
         scenario = Scenario()
         if filename is not None:
@@ -277,10 +355,36 @@ def load_scenario(filename: "str | Path | None" = None, *, scenario_name: str | 
     return scenario
 
 
+def _check_raw(file_text: str | None, scenario_name: str | None, scenario_text: str | None,
+               where: str) -> None:
+    """Checks the documents against the schema (`tg_drake.schema_check`), so that a mistake is
+    reported with its field path and the allowed keys or the expected type."""
+    for text, name in ((file_text, scenario_name), (scenario_text, None)):
+        if not text:
+            continue
+        try:
+            doc = load_raw(text)
+        except yaml.YAMLError as e:
+            raise ScenarioError(f"malformed YAML: {_tidy_yaml_error(str(e))}", file=where) from None
+        if name is not None:
+            entries = [k for k, v in (doc or {}).items() if isinstance(v, dict)] \
+                if isinstance(doc, dict) else []
+            if name not in entries:
+                raise unknown_name("scenario", name, entries, error=ScenarioError, file=where,
+                                   field="--name")
+            doc = doc[name]
+        if doc is None:
+            continue
+        try:
+            check_document(doc, Scenario)
+        except SchemaError as e:
+            raise ScenarioError(e.message, file=where if text is file_text else "<text>",
+                                field=e.path) from None
+
+
 def scenario_names(filename: str | Path) -> list[str]:
     """The named entries of a multi-scenario file (its top-level keys that are mappings)."""
-    with open(filename) as f:
-        data = yaml.safe_load(f) or {}
+    data = load_raw(Path(filename).read_text()) or {}
     schema_keys = {f.name for f in dataclasses.fields(Scenario)}
     return [k for k, v in data.items() if isinstance(v, dict) and k not in schema_keys]
 
@@ -345,6 +449,10 @@ def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
         scenario.pipeline.validate()
     except ScenarioError as e:
         raise ScenarioError(e.message, file=where, field=e.field) from None
+    perception = scenario.pipeline.perception
+    if isinstance(perception, DepthPerception) and perception.camera not in scenario.cameras:
+        raise unknown_name("camera", perception.camera, list(scenario.cameras),
+                           error=ScenarioError, file=where, field="pipeline.perception.camera")
     for name, driver in scenario.model_drivers.items():
         if name not in ("iiwa", "wsg"):
             raise unknown_name("model driver", name, ["iiwa", "wsg"], error=ScenarioError,

@@ -132,7 +132,7 @@ def kernel_priors(seed: int) -> dict[str, dict[str, float]]:
 
 def floored(prior: dict[str, float]) -> dict[str, float]:
     """The kernel prior mixed with the uniform one by the pipeline's floor (PRIOR_FLOOR, as
-    `tg-drake eval` and `PipelineConfig.prior_floor`): a prior certain of a wrong category does
+    `tg-drake eval` and `pipeline.logic.prior_floor`): a prior certain of a wrong category does
     not make the observations impossible."""
     return {c: (1.0 - PRIOR_FLOOR) * prior.get(c, 0.0) + PRIOR_FLOOR / len(CATEGORIES)
             for c in CATEGORIES}

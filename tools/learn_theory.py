@@ -11,7 +11,7 @@
 Data. Every library object, in every pose that suits it, empty, and full when upright (containers
 only), grasped in turn at each of its parts: the pipeline runs with ground-truth perception (the
 paper's S_SYN setting), the task p&pOn (every object affords it; the task does not change what
-the robot does once the part is fixed) and `PipelineConfig.grasp_part` set, so that only that
+the robot does once the part is fixed) and `pipeline.scoring: !OnePart {part: ...}`, so that only that
 part's pre-grasp hypotheses are tried, best P(grasp | shape) first. A position and yaw on the table
 are drawn per scene from the seed. Upside-down pans are left out: the theory's constraint rules
 every grasp of them out, so nothing would be executed. One object per category (drawn from the
@@ -105,7 +105,10 @@ def collection_specs(seed: int) -> list[dict]:
 
 def _scenario(spec: dict, *, task: str, grasp_part: str | None = None, theory: str = "specific"):
     from tg_drake.scenario import (
+        DgiScorer,
+        GroundTruthPerception,
         ObjectPlacement,
+        OnePart,
         PipelineConfig,
         Scenario,
         TaskConfig,
@@ -116,9 +119,10 @@ def _scenario(spec: dict, *, task: str, grasp_part: str | None = None, theory: s
         objects=[ObjectPlacement(id=spec["id"], pose=spec["pose"], xy=spec["xy"],
                                  yaw=spec["yaw"], containment=spec["containment"])],
         task=TaskConfig(task=task, place_xy=PLACE_XY),
-        pipeline=PipelineConfig(perception="ground_truth", grasp_part=grasp_part,
-                                category_theory=theory, grasp_theory=theory,
+        pipeline=PipelineConfig(perception=GroundTruthPerception(),
+                                scoring=OnePart(part=grasp_part) if grasp_part else DgiScorer(),
                                 min_grasp_probability=0.0 if grasp_part else 0.03))
+    scenario.pipeline.logic.category = scenario.pipeline.logic.grasp = theory
     validate(scenario, where=spec["name"])
     return scenario
 
@@ -283,7 +287,7 @@ def pregrasp_e0(records: list[dict]) -> dict:
     from tg_drake.scenario import PipelineConfig
     from tg_drake.types import CATEGORIES, PART_LABELS
 
-    floor = PipelineConfig().prior_floor
+    floor = PipelineConfig().logic.prior_floor
     engines = {k: LogicEngine(TheoryConfig.named(v)) for k, v in THEORIES.items()}
     executed = grasp_records(records)
     by_scene: dict = {}
@@ -396,7 +400,7 @@ def write_results(records: list[dict], e0: dict, success: dict, command: str) ->
              f"the objects {', '.join(out['test_objects'])} (one per category).", "",
              "Data: every library object in every pose that suits it, empty and (upright "
              "containers) full, grasped at each of its parts in turn through the whole pipeline "
-             "(ground-truth perception, `PipelineConfig.grasp_part`). A grasp *served* a task "
+             "(ground-truth perception, `scoring: !OnePart`). A grasp *served* a task "
              "when the object was held through lift and place and the part is one the task "
              "allows (the table in `tg_drake/logic/learning.py`, written from what each task "
              "needs). The learned theory (`rules/grasp_learned.pl`, `rules/category_learned.pl`)"

@@ -212,34 +212,23 @@ def test_query_with_the_learned_theory(capsys):
     assert learned and learned[0].text  # the shipped learned file parses
 
 
-def test_pipeline_accepts_the_learned_theory_and_checks_grasp_part():
+def test_pipeline_accepts_the_learned_theory_and_checks_the_scored_part():
     import argparse
 
     from tg_drake.errors import ScenarioError
+    from tg_drake.logic.engine import LogicQueryConfig
     from tg_drake.run import add_arguments
-    from tg_drake.scenario import PipelineConfig
+    from tg_drake.scenario import OnePart, PipelineConfig
 
-    PipelineConfig(category_theory="learned", grasp_theory="learned", grasp_part="handle"
-                   ).validate()
+    PipelineConfig(logic=LogicQueryConfig(category="learned", grasp="learned"),
+                   scoring=OnePart(part="handle")).validate()
     with pytest.raises(ScenarioError, match="unknown part 'lid'.*allowed: top"):
-        PipelineConfig(grasp_part="lid").validate()
+        PipelineConfig(scoring=OnePart(part="lid")).validate()
+    with pytest.raises(ScenarioError, match="unknown grasp model variant 'learnt'"):
+        PipelineConfig(logic=LogicQueryConfig(grasp="learnt")).validate()
     parser = argparse.ArgumentParser()
     add_arguments(parser)
     assert parser.parse_args(["x.yaml", "--theory", "learned"]).theory == "learned"
-
-
-def test_only_part_keeps_indices_and_order():
-    from tg_drake.systems.grasp_planner import only_part
-    from tg_drake.types import GraspCandidates
-
-    parts = np.array([1, 3, 1, 0])
-    grasps = GraspCandidates(np.zeros((4, 4, 4)), parts, p_part=np.array([.9, 0., .9, .1]),
-                             p_local=np.array([.5, .8, .7, .9]),
-                             score=np.array([.45, 0., .63, .09]))
-    only = only_part(grasps, PART_LABELS[3])
-    assert only.score.tolist() == [0.0, 0.8, 0.0, 0.0]  # a part the logic gave 0 is tried
-    only = only_part(grasps, PART_LABELS[1])
-    assert only.score.tolist() == [0.5, 0.0, 0.7, 0.0]
 
 
 # ---- the collection tool (tools/learn_theory.py) ---------------------------------------------

@@ -79,3 +79,101 @@ def test_malformed_yaml(tmp_path):
 def test_no_objects_target_is_an_error():
     with pytest.raises(ScenarioError, match="no objects"):
         Scenario().target_placement()
+
+
+# ---- the pipeline block: typed stage configs, tagged alternatives ------------------------------
+
+def _load(tmp_path, text, **kwargs):
+    path = tmp_path / "s.yaml"
+    path.write_text("objects:\n  - {id: cup_01}\n" + text)
+    return load_scenario(path, **kwargs)
+
+
+def test_pipeline_alternatives_are_tagged(tmp_path):
+    from tg_drake.scenario import DepthPerception, DgiScorer, GroundTruthPerception, LocalOnly
+
+    default = _load(tmp_path, "").pipeline
+    assert isinstance(default.perception, DepthPerception)
+    assert isinstance(default.scoring, DgiScorer) and default.selection == "pipeline"
+    p = _load(tmp_path, "pipeline:\n  perception: !GroundTruthPerception {spacing: 0.005}\n"
+              "  scoring: !LocalOnly {}\n").pipeline
+    assert isinstance(p.perception, GroundTruthPerception) and p.perception.spacing == 0.005
+    assert isinstance(p.scoring, LocalOnly) and p.selection == "local_only"
+    assert p.prior_config().clouds == "ground_truth"  # follows the perception
+    assert default.prior_config().clouds == "perceived"
+
+
+def test_every_stage_config_is_settable_from_yaml(tmp_path):
+    p = _load(tmp_path, """pipeline:
+  perception: !DepthPerception
+    camera: camera0
+    config: {completion: {sigma: 0.8}, segmentation: {seed: 3}}
+  prior: {n_neighbours: 5}
+  logic: {category: general, grasp: general, use_prior: false, prior_floor: 0.1}
+  planner: {lift_height: 0.2, place_yaws: [0, 90], carry_limits: {velocity_scale: 0.3}}
+""").pipeline
+    assert p.perception.config.completion.sigma == 0.8
+    assert p.perception.config.segmentation.seed == 3
+    assert p.prior.n_neighbours == 5
+    assert (p.logic.category, p.logic.grasp, p.logic.use_prior, p.logic.prior_floor) == (
+        "general", "general", False, 0.1)
+    assert p.planner.lift_height == 0.2 and p.planner.place_yaws == [0, 90]
+    assert p.planner.carry_limits.velocity_scale == 0.3
+    assert p.planner.carry_limits.min_duration == 1.0  # the nested default is kept
+
+
+def test_the_resolved_scenario_round_trips_through_yaml(tmp_path):
+    from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
+
+    from tg_drake.scenario import Scenario
+
+    s = _load(tmp_path, "pipeline:\n  perception: !GroundTruthPerception {}\n"
+              "  planner: {lift_height: 0.2}\n")
+    again = yaml_load_typed(schema=Scenario, data=yaml_dump_typed(s))
+    assert yaml_dump_typed(again) == yaml_dump_typed(s)
+    assert again.pipeline.planner.lift_height == 0.2
+
+
+@pytest.mark.parametrize("text, field, message", [
+    ("pipeline:\n  perception: ground_truth\n", "pipeline.perception",
+     "expected one of !DepthPerception {...} or !GroundTruthPerception {...}, got 'ground_truth'"),
+    ("pipeline:\n  scoring: !Local {}\n", "pipeline.scoring",
+     "unknown alternative !Local (did you mean !LocalOnly?); allowed: !DgiScorer, !LocalOnly"),
+    ("pipeline:\n  planner: {lift_hieght: 0.2}\n", "pipeline.planner.lift_hieght",
+     "unknown field 'lift_hieght' (did you mean 'lift_height'?); allowed: pregrasp_distance"),
+    ("pipeline:\n  logic: {grasp: specfic}\n", "pipeline.logic.grasp",
+     "unknown grasp model variant 'specfic'; allowed: specific, general, learned"),
+    ("pipeline:\n  scoring: !OnePart {part: lid}\n", "pipeline.scoring.part",
+     "unknown part 'lid'; allowed: top"),
+    ("pipeline:\n  category_theory: general\n", "pipeline.category_theory",
+     "unknown field 'category_theory'; allowed: perception, prior, logic, scoring, planner"),
+])
+def test_pipeline_mistakes_name_the_field(tmp_path, text, field, message):
+    with pytest.raises(ScenarioError) as e:
+        _load(tmp_path, text)
+    assert e.value.field == field
+    assert message in str(e.value)
+    assert "s.yaml" in str(e.value)
+
+
+@pytest.mark.parametrize("entry, field, message", [
+    ("{id: cup_01, yaww: 0}", "objects[0].yaww",
+     "unknown field 'yaww' (did you mean 'yaw'?); allowed: id, name, pose, xy, yaw"),
+    ("{id: cup_01, xy: 0.1}", "objects[0].xy", "expected a list, got 0.1"),
+    ("{id: cup_01, yaw: ninety}", "objects[0].yaw", "expected a number, got 'ninety'"),
+    ("[cup_01]", "objects[0]", "expected a mapping with keys among id, name"),
+])
+def test_object_mistakes_name_the_field(tmp_path, entry, field, message):
+    path = tmp_path / "o.yaml"
+    path.write_text(f"objects:\n  - {entry}\n")
+    with pytest.raises(ScenarioError) as e:
+        load_scenario(path)
+    assert e.value.field == field
+    assert message in str(e.value)
+
+
+def test_a_missing_named_entry_lists_the_entries(tmp_path):
+    path = tmp_path / "n.yaml"
+    path.write_text("Mug: {objects: [{id: cup_01}]}\nCan: {objects: [{id: can_01}]}\n")
+    with pytest.raises(ScenarioError, match="unknown scenario 'Mugg'; allowed: Mug, Can"):
+        load_scenario(path, scenario_name="Mugg")

@@ -35,7 +35,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--address", default=None, help="Ray cluster address (e.g. auto)")
     parser.add_argument("--theory", default="specific",
                         help="model variant in place of the specific one for PLM and the pipeline "
-                             "(tg_drake.scenario.THEORY_VARIANTS, e.g. learned); a case's key "
+                             "(tg_drake.logic.theory.VARIANTS, e.g. learned); a case's key "
                              "gets '#<theory>' unless it is specific")
     parser.add_argument("--retry-errors", action="store_true",
                         help="run again the cases recorded as errors")
@@ -129,10 +129,10 @@ def main(args) -> int:
     cases = load_cases(args.suites)
     if args.theory != "specific":
         from tg_drake.errors import ScenarioError, unknown_name
-        from tg_drake.scenario import THEORY_VARIANTS
+        from tg_drake.logic.theory import VARIANTS
 
-        if args.theory not in THEORY_VARIANTS:
-            raise unknown_name("theory", args.theory, THEORY_VARIANTS, error=ScenarioError,
+        if args.theory not in VARIANTS:
+            raise unknown_name("theory", args.theory, VARIANTS, error=ScenarioError,
                                field="--theory")
         cases = [dataclasses.replace(c, key=f"{c.key}#{args.theory}", theory=args.theory)
                  for c in cases]

@@ -223,12 +223,12 @@ def run_perceived(case) -> list[dict]:
 
 def run_executed(case) -> dict:
     from tg_drake.run import run_scenario
-    from tg_drake.scenario import PipelineConfig, Scenario, TaskConfig, validate
+    from tg_drake.scenario import (DgiScorer, LocalOnly, PipelineConfig, Scenario, TaskConfig,
+                                   validate)
 
-    pipeline = PipelineConfig(category_theory=case.theory, grasp_theory=case.theory,
-                              use_prior=case.variant != "pipeline_uniform",
-                              grasp_selection="local_only" if case.variant == "local"
-                              else "pipeline")
+    pipeline = PipelineConfig(scoring=LocalOnly() if case.variant == "local" else DgiScorer())
+    pipeline.logic.category = pipeline.logic.grasp = case.theory
+    pipeline.logic.use_prior = case.variant != "pipeline_uniform"
     scenario = Scenario(objects=list(case.objects), pipeline=pipeline,
                         task=TaskConfig(target=case.target, task=case.task,
                                         place_xy=list(case.place_xy)))

@@ -1,7 +1,8 @@
 """The final grasp score: the logic's P(part | task) times the DGI's P(grasp | local shape).
 
 `selection="local_only"` ranks by P(grasp | local shape) alone, ignoring the logic: the paper's
-Local baseline (section VI, Table "pipeline").
+Local baseline (section VI, Table "pipeline"). `selection="one_part"` scores only the hypotheses of
+one part, by P(grasp | local shape) alone (for collecting grasp outcomes per part).
 """
 
 from __future__ import annotations
@@ -12,19 +13,29 @@ from tg_drake.errors import GraspingError, unknown_name
 from tg_drake.grasping.model import DgiGraspModel
 from tg_drake.types import PART_LABELS, GraspCandidates, GraspSemantics, SceneDescription
 
-SELECTIONS = ("pipeline", "local_only")  # how rank_grasps scores a hypothesis
+SELECTIONS = ("pipeline", "local_only", "one_part")  # how rank_grasps scores a hypothesis
+
+
+def check_selection(selection: str, part: str | None = None) -> None:
+    """Raises GraspingError for an unknown selection, or a "one_part" one without a known part."""
+    if selection not in SELECTIONS:
+        raise unknown_name("grasp selection", selection, SELECTIONS, error=GraspingError)
+    if selection == "one_part" and part not in PART_LABELS:
+        raise unknown_name("part", str(part), PART_LABELS, error=GraspingError, field="part")
 
 
 def rank_grasps(scene: SceneDescription, semantics: GraspSemantics,
-                model: DgiGraspModel, *, selection: str = "pipeline") -> GraspCandidates:
+                model: DgiGraspModel, *, selection: str = "pipeline",
+                part: str | None = None) -> GraspCandidates:
     """Every pre-grasp hypothesis of the target object, scored and sorted best first.
 
     p_local = P(grasp | local shape) from the DGI model, p_part = the logic's P(part | task) of the
     hypothesis' part (0 for a part the logic did not name), score = p_part · p_local
-    (`selection="pipeline"`) or p_local alone (`"local_only"`). Ties keep the hypotheses' order.
+    (`selection="pipeline"`) or p_local alone (`"local_only"`), or p_local for the hypotheses of
+    `part` and 0 for the others (`"one_part"`: a part the logic gives 0 is still ranked). Ties
+    keep the hypotheses' order.
     """
-    if selection not in SELECTIONS:
-        raise unknown_name("grasp selection", selection, SELECTIONS, error=GraspingError)
+    check_selection(selection, part)
     target = semantics.target
     if not 0 <= target < len(scene.objects):
         raise GraspingError(
@@ -45,7 +56,12 @@ def rank_grasps(scene: SceneDescription, semantics: GraspSemantics,
         return GraspCandidates(np.zeros((0, 4, 4)), parts, empty, empty, empty, target)
     p_local = model.p_grasp(obj.p_W, X_WG)
     p_part = np.array([semantics.part.get(PART_LABELS[k], 0.0) for k in parts], dtype=float)
-    score = p_part * p_local if selection == "pipeline" else p_local
+    if selection == "pipeline":
+        score = p_part * p_local
+    elif selection == "local_only":
+        score = p_local
+    else:
+        score = np.where(parts == PART_LABELS.index(part), p_local, 0.0)
     order = np.argsort(-score, kind="stable")
     return GraspCandidates(X_WG[order], parts[order], p_part[order], p_local[order], score[order],
                            target)

@@ -9,7 +9,6 @@ cross-validation for perceived queries.
 reads that file once per process.
 """
 
-from __future__ import annotations
 
 import functools
 import importlib.resources
@@ -43,8 +42,9 @@ class KernelPriorConfig:
     # `clouds` (leave-one-object-out).
     entries: str | None = None  # database graphs compared with: "all", "ground_truth",
     # "perceived"; None: the database's cross-validated choice for `clouds`.
-    clouds: str = "perceived"  # what the queries are: "perceived" clouds (perception's), or
+    clouds: str | None = None  # what the queries are: "perceived" clouds (perception's), or
     # "ground_truth" samplings of the meshes; picks the database's choice of T and entries.
+    # None: "perceived" (the pipeline sets it from its perception variant).
     n_neighbours: int = N_NEIGHBOURS  # n most similar database graphs averaged into the prior.
     database: str | None = None  # path of a kernel_db.npz; None: the one shipped in tg_drake/data.
 
@@ -115,7 +115,7 @@ class KernelDatabase:
     @classmethod
     def build(cls, clouds: list[LabelledCloud], object_ids, categories, *,
               projections: LshProjections, spacing: float, k: int = K_NEIGHBOURS,
-              t_default: int = 0, **entry_info) -> KernelDatabase:
+              t_default: int = 0, **entry_info) -> "KernelDatabase":
         """Hashes already resampled clouds into a database (one block-diagonal diffusion).
         `entry_info`: sources, poses, yaws, viewpoints (one per cloud), entries_default."""
         ids = np.asarray(object_ids, dtype=str)
@@ -246,7 +246,7 @@ class KernelDatabase:
         np.savez_compressed(path, **arrays)
 
     @classmethod
-    def load(cls, path) -> KernelDatabase:
+    def load(cls, path) -> "KernelDatabase":
         """Reads a database written by `save` (a path or a binary file object)."""
         try:
             data = np.load(path, allow_pickle=False)

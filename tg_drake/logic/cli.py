@@ -10,13 +10,15 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from tg_drake.logic.theory import VARIANTS
+
 HELP = "ask the ProbLog theory for category, task and pre-grasp part on given observations"
 
 
 def add_arguments(parser) -> None:
     parser.add_argument("observations", type=Path, help="observations file (YAML)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
-    parser.add_argument("--theory", choices=("specific", "general", "learned"),
+    parser.add_argument("--theory", choices=VARIANTS,
                         default="specific",
                         help="category and grasp model variant (default: specific; learned: "
                         "fitted by tools/learn_theory.py)")

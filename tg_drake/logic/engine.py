@@ -30,7 +30,6 @@ probability and p_without the same with the rule taken out (its switch or choice
 0) or the observation dropped; all reasons are one batched pass of the circuit.
 """
 
-from __future__ import annotations
 
 import functools
 from dataclasses import dataclass, field

@@ -4,7 +4,6 @@ Every field has a default and a unit. The defaults are the values our evaluation
 (`tools/eval_perception.py`); the paper gives only σ's meaning, not its value.
 """
 
-from __future__ import annotations
 
 from dataclasses import dataclass, field
 

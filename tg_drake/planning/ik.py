@@ -21,7 +21,7 @@ from pydrake.multibody.tree import SpatialInertia
 from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 from pydrake.systems.framework import DiagramBuilder
 
-from tg_drake.scenario import IIWA_HOME, Scenario, default_directives
+from tg_drake.robot import IIWA_HOME
 
 
 # Weight of the IK's pull towards its seed [1/rad²]: a preference among the solutions that meet
@@ -49,7 +49,7 @@ class ArmPlant:
         return q
 
 
-def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
+def make_arm_plant(scenario=None, *, obstacles=(),
                    finger_opening: float = 0.11, held=None, finger_contact=()) -> ArmPlant:
     """A kinematic model of the arm for IK and collision checking.
 
@@ -63,6 +63,10 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
         the rest of the arm and gripper still keeps clear of them.
     """
     from tg_drake.station import make_parser
+
+    # The scenario schema composes the planner's config, which imports this module: import the
+    # schema when an arm plant is made, not when this module loads.
+    from tg_drake.scenario import Scenario, default_directives
 
     scenario = scenario or Scenario()
     builder = DiagramBuilder()

@@ -38,7 +38,6 @@ Obstacles are the perceived objects' bounding boxes (`ObjectDescription.X_WO`, `
 held object is its bounding box welded to the gripper.
 """
 
-from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
@@ -51,7 +50,7 @@ from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.trajectory import (SegmentConfig, SegmentLimits, StraightLine,
                                           plan_segment, shifted)
 from tg_drake.perception.pregrasp import WSG_GRASP_POINT_G
-from tg_drake.scenario import IIWA_HOME, Scenario
+from tg_drake.robot import IIWA_HOME
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, SceneDescription
 
 
@@ -89,12 +88,12 @@ class PlannerConfig:
     # lift, descent, place, retreat), where the fingers straddle the object.
     ik_position_tolerance: float = 0.002  # [m] per axis.
     ik_angle_tolerance: float = 0.02  # [rad]
-    seed_postures: tuple = (
-        IIWA_HOME,
-        (0.0, 0.6, 0.0, -1.3, 0.0, 1.0, 0.0),  # reaching forward and low
-        (0.0, 0.3, 0.0, -1.6, 0.0, -1.0, 0.0),  # wrist flipped
-        (0.0, 0.2, 0.0, -1.0, 0.0, 1.6, 0.0),  # from above
-    )  # [rad] IK seeds; each is also tried with joint 1 turned towards the target.
+    seed_postures: list[list[float]] = field(default_factory=lambda: [
+        list(IIWA_HOME),
+        [0.0, 0.6, 0.0, -1.3, 0.0, 1.0, 0.0],  # reaching forward and low
+        [0.0, 0.3, 0.0, -1.6, 0.0, -1.0, 0.0],  # wrist flipped
+        [0.0, 0.2, 0.0, -1.0, 0.0, 1.6, 0.0],  # from above
+    ])  # [rad] IK seeds; each is also tried with joint 1 turned towards the target.
     min_pad_depth: float = 0.007  # [m] how far along the pads (the approach) the object must
     # reach between them. A spatula's 12 mm handle lying flat reaches 8 mm above the pads' tips
     # (TABLE_CLEARANCE over the table) and held when taken straight down; 10 mm refused it. Flat
@@ -132,7 +131,8 @@ class PlannerConfig:
     # logic moves on to the next part).
     max_length_ratio: float = 2.0  # fingers do not close along a part's length when it is this
     # many times longer than its other extents (a knife's handle, taken end to end, slipped out).
-    place_yaws: tuple = (0.0, 60.0, -60.0, 120.0, -120.0, 180.0)  # [deg] turns of the object
+    place_yaws: list[float] = field(
+        default_factory=lambda: [0.0, 60.0, -60.0, 120.0, -120.0, 180.0])  # [deg] turns of the object
     # about the vertical tried at the place, in order (the first one that can be planned).
     max_candidates_per_part: int = 12  # candidates per part that reach the inverse kinematics
     # before the part is given up (those the cheap geometric checks refuse do not count).
@@ -140,10 +140,10 @@ class PlannerConfig:
     # closing axis through its grasp point by these angles [deg]: the fingers still close across
     # the same part, and the wrist rises clear of the table (horizontal grasps low on an object
     # are out of the iiwa's reach at the table's distance).
-    approach_tilts: tuple = (10.0, 20.0, 35.0)
+    approach_tilts: list[float] = field(default_factory=lambda: [10.0, 20.0, 35.0])
     # A steep (top-down) grasp is also tried with its wrist tilted back towards the robot about
     # the closing axis by these angles [deg] (only when the closing axis lets it lean that way).
-    top_tilts: tuple = (15.0, 30.0)
+    top_tilts: list[float] = field(default_factory=lambda: [15.0, 30.0])
     free_limits: SegmentLimits = field(default_factory=SegmentLimits)  # moving to the pre-grasp
     contact_limits: SegmentLimits = field(default_factory=lambda: SegmentLimits(
         velocity_scale=0.25, min_duration=1.0))  # straight moves at the object
@@ -228,7 +228,7 @@ def plan_for_scene(scene: SceneDescription, candidates: GraspCandidates, *, plac
 
 def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescription,
                         obstacles=(), place_xy, q_start=IIWA_HOME, table_z: float = 0.0,
-                        config: PlannerConfig | None = None, scenario: Scenario | None = None,
+                        config: PlannerConfig | None = None, scenario=None,
                         exclude_parts=(), max_parts: int | None = None) -> PlanResult:
     """The first candidate (by score) with a full collision-free pick-and-place plan.
 

@@ -23,7 +23,6 @@ plant's opening (equal lower and upper bounds) and dropped from the returned tra
 has the 7 iiwa joints as its rows.
 """
 
-from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field

@@ -6,9 +6,8 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
-from tg_drake.errors import GraspingError, unknown_name
 from tg_drake.grasping.model import DgiGraspModel, load_default_model
-from tg_drake.grasping.scoring import SELECTIONS, rank_grasps
+from tg_drake.grasping.scoring import check_selection, rank_grasps
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 
@@ -30,14 +29,16 @@ class DgiScoringSystem(LeafSystem):
     holds them all with score = P(part | task) · P(grasp | local shape), best first.
 
     The model is the one shipped with the package unless `model` is given. `selection`
-    "local_only" ranks by P(grasp | local shape) alone (the paper's Local baseline).
+    "local_only" ranks by P(grasp | local shape) alone (the paper's Local baseline); "one_part"
+    ranks only the hypotheses of `part`, by P(grasp | local shape) (`rank_grasps`).
     """
 
-    def __init__(self, model: DgiGraspModel | None = None, *, selection: str = "pipeline"):
+    def __init__(self, model: DgiGraspModel | None = None, *, selection: str = "pipeline",
+                 part: str | None = None):
         super().__init__()
-        if selection not in SELECTIONS:
-            raise unknown_name("grasp selection", selection, SELECTIONS, error=GraspingError)
+        check_selection(selection, part)
         self._selection = selection
+        self._part = part
         self._model = model if model is not None else load_default_model()
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description",
@@ -70,4 +71,4 @@ class DgiScoringSystem(LeafSystem):
     def _calc_ranked_grasps(self, context, output):
         output.set_value(rank_grasps(self._scene_port.Eval(context),
                                      self._semantics_port.Eval(context), self._model,
-                                     selection=self._selection))
+                                     selection=self._selection, part=self._part))

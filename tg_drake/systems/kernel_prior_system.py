@@ -42,7 +42,7 @@ class KernelPriorSystem(LeafSystem):
             self._config.database)
         # The database's cross-validated T and entries for these clouds, unless the config
         # names them; checked now rather than at the first evaluation.
-        entries, t = self._database.choice(self._config.clouds)
+        entries, t = self._database.choice(self._config.clouds or "perceived")
         self._entries = self._database.resolve_entries(
             entries if self._config.entries is None else self._config.entries)
         self._iterations = self._database.resolve_iterations(

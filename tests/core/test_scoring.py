@@ -1,0 +1,58 @@
+"""The final grasp score (tg_drake.grasping.scoring.rank_grasps) for each selection."""
+
+import numpy as np
+import pytest
+
+from tg_drake.errors import GraspingError
+from tg_drake.grasping.scoring import rank_grasps
+from tg_drake.types import PART_LABELS, GraspSemantics, ObjectDescription, SceneDescription
+
+P_LOCAL = np.array([0.5, 0.8, 0.7, 0.9])  # per hypothesis, in the object's order
+PARTS = np.array([1, 3, 1, 0])  # middle, handle, middle, top
+
+
+class FixedModel:
+    """A stand-in for the DGI model: P(grasp | local shape) given per hypothesis."""
+
+    def p_grasp(self, p_W, X_WG):
+        assert len(X_WG) == len(P_LOCAL)
+        return P_LOCAL
+
+
+def scene():
+    obj = ObjectDescription(
+        p_W=np.zeros((10, 3)), n_W=np.zeros((10, 3)), labels=np.zeros(10, int),
+        visible=np.ones(10, bool), X_WO=np.eye(4), extents=np.full(3, 0.1), pose="upright",
+        pose_likelihood={"upright": 1.0}, part_probabilities={}, part_boxes={},
+        pregrasp_X_WG=np.tile(np.eye(4), (4, 1, 1)), pregrasp_parts=PARTS)
+    return SceneDescription(objects=[obj], X_WT=np.eye(4))
+
+
+SEMANTICS = GraspSemantics(category={}, task={}, part={"middle": 0.9, "top": 0.1},
+                           given_task=None)
+
+
+def test_pipeline_multiplies_part_and_local_shape():
+    ranked = rank_grasps(scene(), SEMANTICS, FixedModel())
+    assert np.allclose(ranked.score, [0.63, 0.45, 0.09, 0.0])  # handle: the logic gave it 0
+    assert ranked.parts.tolist() == [1, 1, 0, 3]
+
+
+def test_local_only_ignores_the_logic():
+    ranked = rank_grasps(scene(), SEMANTICS, FixedModel(), selection="local_only")
+    assert np.allclose(ranked.score, [0.9, 0.8, 0.7, 0.5])
+
+
+def test_one_part_scores_only_that_part_even_where_the_logic_gives_it_zero():
+    ranked = rank_grasps(scene(), SEMANTICS, FixedModel(), selection="one_part", part="handle")
+    assert np.allclose(ranked.score, [0.8, 0.0, 0.0, 0.0])
+    assert ranked.parts[0] == PART_LABELS.index("handle")
+    ranked = rank_grasps(scene(), SEMANTICS, FixedModel(), selection="one_part", part="middle")
+    assert np.allclose(ranked.score, [0.7, 0.5, 0.0, 0.0])
+
+
+def test_unknown_selection_or_part_is_refused():
+    with pytest.raises(GraspingError, match="unknown grasp selection 'best'; allowed: pipeline"):
+        rank_grasps(scene(), SEMANTICS, FixedModel(), selection="best")
+    with pytest.raises(GraspingError, match="unknown part 'lid'"):
+        rank_grasps(scene(), SEMANTICS, FixedModel(), selection="one_part", part="lid")
