@@ -260,7 +260,8 @@ class PipelineConfig:
     def validate(self, where: str = "pipeline") -> None:
         """Checks names the YAML types cannot; raises ScenarioError naming the field."""
         if isinstance(self.perception, DepthPerception) and not self.perception.camera:
-            raise ScenarioError("perception needs a camera name", field=f"{where}.perception.camera")
+            raise ScenarioError("perception needs a camera name",
+                                field=f"{where}.perception.camera")
         if isinstance(self.perception, GroundTruthPerception) and not self.perception.spacing > 0:
             raise ScenarioError(f"spacing must be > 0 [m], got {self.perception.spacing}",
                                 field=f"{where}.perception.spacing")
@@ -340,8 +341,14 @@ def load_scenario(filename: "str | Path | None" = None, *, scenario_name: str | 
     where = str(filename) if filename is not None else "<text>"
     if filename is not None and not Path(filename).is_file():
         raise ScenarioError("no such scenario file", file=where)
-    _check_raw(Path(filename).read_text() if filename is not None else None, scenario_name,
-               scenario_text, where)
+    try:
+        text = Path(filename).read_text(encoding="utf-8") if filename is not None else None
+    except UnicodeDecodeError as e:
+        raise ScenarioError(f"not a UTF-8 text file ({e.reason} at byte {e.start})",
+                            file=where) from None
+    except OSError as e:
+        raise ScenarioError(f"cannot read the file: {e.strerror}", file=where) from None
+    _check_raw(text, scenario_name, scenario_text, where)
     try:
         scenario = Scenario()
         if filename is not None:
@@ -366,6 +373,8 @@ def _check_raw(file_text: str | None, scenario_name: str | None, scenario_text: 
             doc = load_raw(text)
         except yaml.YAMLError as e:
             raise ScenarioError(f"malformed YAML: {_tidy_yaml_error(str(e))}", file=where) from None
+        except SchemaError as e:
+            raise ScenarioError(e.message, file=where) from None
         if name is not None:
             entries = [k for k, v in (doc or {}).items() if isinstance(v, dict)] \
                 if isinstance(doc, dict) else []
@@ -389,13 +398,21 @@ def scenario_names(filename: str | Path) -> list[str]:
     return [k for k, v in data.items() if isinstance(v, dict) and k not in schema_keys]
 
 
+MAX_MESSAGE = 400  # characters of a loader's message quoted in ours
+
+
 def _tidy_yaml_error(message: str) -> str:
-    # Drake's messages are precise but long; keep them, only trim whitespace.
-    return " ".join(message.split())
+    # Drake's messages are precise but can quote a whole value: trim whitespace and length.
+    message = " ".join(message.split())
+    return message if len(message) <= MAX_MESSAGE else message[:MAX_MESSAGE] + "…"
 
 
 def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
     """Checks names and geometry that YAML typing alone cannot."""
+    if len(scenario.table_size) != 2 or not all(
+            _finite(v) and v > 0 for v in scenario.table_size):
+        raise ScenarioError(f"need two sizes > 0 [m], got {scenario.table_size}", file=where,
+                            field="table_size")
     names = set()
     half = np.asarray(scenario.table_size) / 2
     for i, placement in enumerate(scenario.objects):
@@ -457,3 +474,142 @@ def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
         if name not in ("iiwa", "wsg"):
             raise unknown_name("model driver", name, ["iiwa", "wsg"], error=ScenarioError,
                                file=where, field="model_drivers")
+    try:
+        _validate_simulation(scenario)
+        _validate_geometry(scenario)
+    except ScenarioError as e:
+        raise ScenarioError(e.message, file=where, field=e.field) from None
+
+
+# Drake's names (MultibodyPlantConfig): contact models, discrete approximations, surfaces.
+CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
+DISCRETE_APPROXIMATIONS = ("tamsi", "sap", "similar", "lagged")
+CONTACT_SURFACES = ("triangle", "polygon")
+
+
+def _finite(value) -> bool:
+    try:
+        return bool(np.all(np.isfinite(np.asarray(value, float))))
+    except (TypeError, ValueError):
+        return False
+
+
+def _positive(value, field: str, unit: str, *, allow_zero: bool = False) -> None:
+    ok = _finite(value) and (value >= 0 if allow_zero else value > 0)
+    if not ok:
+        raise ScenarioError(f"must be a finite number {'≥' if allow_zero else '>'} 0 [{unit}], "
+                            f"got {value}", field=field)
+
+
+def _validate_simulation(scenario: Scenario) -> None:
+    """The plant, the drivers, the cameras and the simulator: values that would hang, diverge or
+    fail deep inside Drake."""
+    plant = scenario.plant_config
+    _positive(plant.time_step, "plant_config.time_step", "s")  # 0 makes a continuous plant
+    _positive(plant.penetration_allowance, "plant_config.penetration_allowance", "m")
+    _positive(plant.stiction_tolerance, "plant_config.stiction_tolerance", "m/s")
+    for name, allowed in (("contact_model", CONTACT_MODELS),
+                          ("discrete_contact_approximation", DISCRETE_APPROXIMATIONS),
+                          ("contact_surface_representation", CONTACT_SURFACES)):
+        if getattr(plant, name) not in allowed:
+            raise unknown_name(name.replace("_", " "), getattr(plant, name), allowed,
+                               error=ScenarioError, field=f"plant_config.{name}")
+    for name, driver in scenario.model_drivers.items():
+        for f in dataclasses.fields(driver):
+            value = getattr(driver, f.name)
+            if isinstance(value, bool):
+                continue
+            _positive(value, f"model_drivers.{name}.{f.name}", "the driver's unit",
+                      allow_zero=f.name != "force_limit")
+    for name, camera in scenario.cameras.items():
+        f = f"cameras.{name}"
+        for size in ("width", "height"):
+            if not getattr(camera, size) > 0:
+                raise ScenarioError(f"must be > 0 [px], got {getattr(camera, size)}",
+                                    field=f"{f}.{size}")
+        fov = camera.focal
+        for axis in ("x", "y"):
+            value = getattr(fov, axis, None)
+            if value is not None and isinstance(fov, CameraConfig.FovDegrees) and not (
+                    _finite(value) and 0 < value < 180):
+                raise ScenarioError(f"a field of view must be in (0, 180) [deg], got {value}",
+                                    field=f"{f}.focal.{axis}")
+            if value is not None and isinstance(fov, CameraConfig.FocalLength) and not (
+                    _finite(value) and value > 0):
+                raise ScenarioError(f"a focal length must be > 0 [px], got {value}",
+                                    field=f"{f}.focal.{axis}")
+        for near, far in (("clipping_near", "clipping_far"), ("z_near", "z_far")):
+            a, b = getattr(camera, near), getattr(camera, far)
+            if not (_finite([a, b]) and 0 < a < b):
+                raise ScenarioError(f"need 0 < {near} < {far} [m], got {a} and {b}",
+                                    field=f"{f}.{near}")
+    if not (_finite(scenario.simulation_duration) and scenario.simulation_duration > 0):
+        raise ScenarioError(f"must be a finite number > 0 [s], got "
+                            f"{scenario.simulation_duration}", field="simulation_duration")
+    sim = scenario.simulator_config
+    _positive(sim.max_step_size, "simulator_config.max_step_size", "s")
+    _positive(sim.target_realtime_rate, "simulator_config.target_realtime_rate", "1",
+              allow_zero=True)
+    if sim.use_error_control:
+        _positive(sim.accuracy, "simulator_config.accuracy", "1")
+    p = scenario.pipeline
+    for name in ("max_requeries",):
+        if getattr(p, name, 0) < 0:
+            raise ScenarioError(f"must be ≥ 0, got {getattr(p, name)}", field=f"pipeline.{name}")
+    if hasattr(p, "min_grasp_probability") and not 0 <= p.min_grasp_probability <= 1:
+        raise ScenarioError(f"a probability must be in [0, 1], got {p.min_grasp_probability}",
+                            field="pipeline.min_grasp_probability")
+
+
+# Two objects whose shapes overlap deeper than this interpenetrate [m]: the library's meshes are
+# placed by their resting poses on the table, so objects that only touch overlap by rounding.
+INTERPENETRATION_DEPTH = 0.002
+
+
+def _footprint_points(scenario: Scenario, placement: ObjectPlacement) -> np.ndarray:
+    """(V, 3) the object's mesh vertices in the table frame T, as placed [m]."""
+    from tg_drake.objects import get_object, mesh
+
+    obj = get_object(placement.id)
+    X_TO = np.asarray(obj.resting_pose(placement.pose).X_TO)
+    yaw = np.deg2rad(placement.yaw)
+    X_T = np.eye(4)
+    X_T[:2, :2] = [[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]]
+    X_T[:2, 3] = placement.xy
+    X = X_T @ X_TO
+    return mesh(obj)[0] @ X[:3, :3].T + X[:3, 3]
+
+
+def _validate_geometry(scenario: Scenario) -> None:
+    """Finite poses, the place target on the table, and objects that do not interpenetrate."""
+    half = np.asarray(scenario.table_size) / 2
+    for i, placement in enumerate(scenario.objects):
+        if not _finite(placement.yaw):
+            raise ScenarioError(f"yaw must be a finite number [deg], got {placement.yaw}",
+                                field=f"objects[{i}].yaw")
+    place = scenario.task.place_xy
+    if len(place) != 2 or not _finite(place):
+        raise ScenarioError(f"place_xy must be two finite numbers [m], got {place}",
+                            field="task.place_xy")
+    if np.any(np.abs(place) > half):
+        raise ScenarioError(f"the place target {list(place)} is off the table (|x| ≤ {half[0]}, "
+                            f"|y| ≤ {half[1]} in the table frame)", field="task.place_xy")
+    if len(scenario.objects) < 2:
+        return
+    from scipy.spatial import ConvexHull
+
+    points = [_footprint_points(scenario, p) for p in scenario.objects]
+    hulls = [ConvexHull(p) for p in points]
+    for i in range(len(points)):
+        for j in range(len(points)):
+            if i == j:
+                continue
+            # Depth of each vertex of i inside j's convex hull (the facets' outward planes).
+            eq = hulls[j].equations
+            depth = -np.max(points[i] @ eq[:, :3].T + eq[:, 3], axis=1)
+            if np.max(depth) > INTERPENETRATION_DEPTH:
+                a, b = scenario.objects[i], scenario.objects[j]
+                raise ScenarioError(
+                    f"{a.instance_name} (objects[{i}]) and {b.instance_name} (objects[{j}]) "
+                    f"interpenetrate by {np.max(depth) * 1000:.0f} mm; move them apart",
+                    field=f"objects[{max(i, j)}].xy")

@@ -19,6 +19,8 @@ import numpy as np
 import yaml
 
 MAX_QUOTE = 80  # characters of a value quoted in a message
+MAX_BYTES = 2_000_000  # a document larger than this is refused [bytes]
+MAX_VALUES = 200_000  # ... and one whose aliases expand to more values than this
 
 
 class SchemaError(ValueError):
@@ -54,8 +56,28 @@ _TaggedLoader.add_multi_constructor("!", _construct_tagged)
 
 
 def load_raw(text: str):
-    """The document with its tags kept (raises yaml.YAMLError when malformed)."""
-    return yaml.load(text, Loader=_TaggedLoader)
+    """The document with its tags kept (raises yaml.YAMLError when malformed, SchemaError when
+    larger than MAX_BYTES)."""
+    if len(text.encode("utf-8", "replace")) > MAX_BYTES:
+        raise SchemaError(f"the document is larger than {MAX_BYTES:,} bytes", "")
+    doc = yaml.load(text, Loader=_TaggedLoader)
+    _count_values(doc, [0])
+    return doc
+
+
+def _count_values(value, seen: list) -> None:
+    """Raises SchemaError when `value` holds more than MAX_VALUES values, counting each use of
+    an alias again (as a loader copying the document would)."""
+    seen[0] += 1
+    if seen[0] > MAX_VALUES:
+        raise SchemaError(f"the document expands to more than {MAX_VALUES:,} values (through "
+                          "aliases?)", "")
+    if isinstance(value, dict):
+        for item in value.values():
+            _count_values(item, seen)
+    elif isinstance(value, list):
+        for item in value:
+            _count_values(item, seen)
 
 
 def _quote(value) -> str:
@@ -98,7 +120,8 @@ def _is_number(value) -> bool:
 
 
 def check_document(value, schema, path: str = "") -> None:
-    """Raises SchemaError at the first place where `value` does not fit `schema`."""
+    """Raises SchemaError at the first place where `value` does not fit `schema` (a document
+    from `load_raw`, whose size is bounded)."""
     where = path or "the document"
     members = _union_members(schema)
     if members is not None:

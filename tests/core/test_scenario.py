@@ -177,3 +177,69 @@ def test_a_missing_named_entry_lists_the_entries(tmp_path):
     path.write_text("Mug: {objects: [{id: cup_01}]}\nCan: {objects: [{id: can_01}]}\n")
     with pytest.raises(ScenarioError, match="unknown scenario 'Mugg'; allowed: Mug, Can"):
         load_scenario(path, scenario_name="Mugg")
+
+
+# ---- validation before anything is built -----------------------------------------------------
+
+@pytest.mark.parametrize("text, field, message", [
+    ("plant_config: {time_step: 0}\n", "plant_config.time_step", "> 0 [s], got 0"),
+    ("plant_config: {time_step: .nan}\n", "plant_config.time_step", "got nan"),
+    ("plant_config: {contact_model: hydro}\n", "plant_config.contact_model",
+     "unknown contact model 'hydro'; allowed: point, hydroelastic"),
+    ("plant_config: {discrete_contact_approximation: sapp}\n",
+     "plant_config.discrete_contact_approximation", "allowed: tamsi, sap, similar, lagged"),
+    ("model_drivers: {iiwa: !JointPdDriver {kp: -1}}\n", "model_drivers.iiwa.kp", "≥ 0"),
+    ("model_drivers: {wsg: !WsgPdDriver {force_limit: 0}}\n", "model_drivers.wsg.force_limit",
+     "> 0"),
+    ("cameras: {camera0: {width: 0}}\n", "cameras.camera0.width", "> 0 [px], got 0"),
+    ("cameras: {camera0: {focal: !FovDegrees {y: 190}}}\n", "cameras.camera0.focal.y",
+     "(0, 180) [deg], got 190"),
+    ("cameras: {camera0: {clipping_near: 2.0, clipping_far: 1.0}}\n",
+     "cameras.camera0.clipping_near", "need 0 < clipping_near < clipping_far"),
+    ("simulation_duration: .inf\n", "simulation_duration", "finite number > 0 [s], got inf"),
+    ("simulator_config: {max_step_size: 0}\n", "simulator_config.max_step_size", "> 0 [s]"),
+    ("task: {place_xy: [0.0, -0.9]}\n", "task.place_xy", "is off the table"),
+    ("task: {place_xy: [.nan, 0]}\n", "task.place_xy", "two finite numbers"),
+    ("table_size: [0.8, -1]\n", "table_size", "two sizes > 0"),
+])
+def test_simulation_settings_are_checked_before_building(tmp_path, text, field, message):
+    with pytest.raises(ScenarioError) as e:
+        _load(tmp_path, text)
+    assert e.value.field == field
+    assert message in str(e.value)
+
+
+def test_interpenetrating_objects_are_refused(tmp_path):
+    path = tmp_path / "i.yaml"
+    path.write_text("objects:\n  - {id: cup_02, xy: [0.0, 0.0]}\n"
+                    "  - {id: glass_01, xy: [0.0, 0.02]}\n")
+    with pytest.raises(ScenarioError, match="cup_02 .objects.0.. and glass_01 .objects.1.. "
+                       "interpenetrate by [0-9]+ mm"):
+        load_scenario(path)
+    path.write_text("objects:\n  - {id: cup_02, xy: [0.0, 0.0]}\n"
+                    "  - {id: glass_01, xy: [0.0, 0.2]}\n")
+    assert len(load_scenario(path).objects) == 2  # 20 cm apart
+
+
+def test_input_size_limits(tmp_path):
+    bomb = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+        for p, c in zip("abcdefgh", "bcdefghi", strict=True)) + "objects: *i\n"
+    path = tmp_path / "bomb.yaml"
+    path.write_text(bomb)  # 10⁹ values from 700 bytes
+    with pytest.raises(ScenarioError, match="expands to more than"):
+        load_scenario(path)
+    big = tmp_path / "big.yaml"
+    big.write_text("# " + "x" * 3_000_000 + "\n")
+    with pytest.raises(ScenarioError, match="larger than"):
+        load_scenario(big)
+    binary = tmp_path / "bin.yaml"
+    binary.write_bytes(b"\xff\xfe\x00objects: []")
+    with pytest.raises(ScenarioError, match="not a UTF-8 text file"):
+        load_scenario(binary)
+
+
+def test_a_long_value_is_quoted_short(tmp_path):
+    with pytest.raises(ScenarioError) as e:
+        _load(tmp_path, "simulation_duration: [" + ", ".join(["1"] * 5000) + "]\n")
+    assert len(str(e.value)) < 400
