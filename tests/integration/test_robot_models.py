@@ -155,3 +155,21 @@ def test_a_robot_plant_names_a_model_the_scenario_lacks():
                                     and not (d.add_weld and d.add_weld.child.startswith("table"))])
     with pytest.raises(ScenarioError, match="no model named table"):
         model_directives(scenario, ("iiwa", "wsg", "table"))
+
+
+def test_the_inverse_dynamics_controller_models_the_arm_with_the_gripper_as_payload():
+    from tg_drake.scenario import InverseDynamicsDriver
+    from tg_drake.station import add_station
+
+    scenario = Scenario()
+    scenario.cameras = {}
+    scenario.model_drivers["iiwa"] = InverseDynamicsDriver()
+    builder = DiagramBuilder()
+    add_station(builder, scenario=scenario)
+    control = builder.GetSubsystemByName("iiwa_inverse_dynamics").get_multibody_plant_for_control()
+    assert control.HasModelInstanceNamed("iiwa") and control.HasModelInstanceNamed("wsg")
+    assert not control.HasModelInstanceNamed("table")
+    assert control.num_positions() == 7  # the finger joints welded: they ride as payload
+    wsg = control.GetModelInstanceByName("wsg")
+    assert control.GetBodyByName(robot.WSG_BODY, wsg).default_mass() \
+        == pytest.approx(robot.WSG_BODY_MASS)
