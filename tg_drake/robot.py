@@ -92,9 +92,11 @@ WSG_OPEN_POSITIONS = (-WSG_STROKE, WSG_STROKE)  # [m] the finger joints fully op
 
 # --- The WSG on the iiwa -------------------------------------------------------------------------
 
-# The mount: G's origin 0.114 m out along link 7's z axis, the approach +y_G along that axis
-# (the data sheet: the body sits about 0.114 m out along the flange's z axis). Roll, pitch, yaw
-# [rad] and translation [m] of G in link 7's frame.
+# The mount: G's origin 0.114 m out along link 7's z axis, the approach +y_G along that axis.
+# The data sheet's figure is the body's centre about 0.114 m out along the flange's z axis; the
+# station measures it from link 7's frame (the flange is IIWA_FLANGE_Z further out), which puts the
+# housing's back face 0.0115 m past the flange. Roll, pitch, yaw [rad] and translation [m] of G in
+# link 7's frame.
 X_7G_RPY = (np.pi / 2, 0.0, np.pi / 2)
 X_7G_XYZ = (0.0, 0.0, 0.114)
 

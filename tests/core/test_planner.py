@@ -99,7 +99,7 @@ def test_pregrasp_into_the_box_is_refused_when_the_box_is_an_obstacle():
 
 def test_velocity_limits_are_the_robot_facts():
     arm = make_arm_plant()
-    # robot_facts.md, max velocity of joints 1–7 [rad/s].
+    # The KUKA data sheet's max velocity of joints 1–7 [rad/s].
     np.testing.assert_array_equal(IIWA_VELOCITY_LIMITS,
                                   [1.48353, 1.48353, 1.74533, 1.30900, 2.26893, 2.35619, 2.35619])
     np.testing.assert_allclose(arm.plant.GetVelocityUpperLimits()[arm.iiwa_indices],

@@ -1,8 +1,9 @@
 """Inverse kinematics for the iiwa + WSG: joint positions that put the gripper frame G at a pose.
 
 The arm model for planning is a separate plant (`make_arm_plant`): the iiwa, the WSG welded to its
-flange with its fingers fixed open, the table, optional obstacles (boxes) welded where the
-perceived objects are, and optionally a held object (a box welded to the gripper frame G).
+flange with its fingers fixed open, the table (those models of the scenario's directives, through
+`tg_drake.robot_plants`), optional obstacles (boxes) welded where the perceived objects are, and
+optionally a held object (a box welded to the gripper frame G).
 Collision avoidance uses minimum-distance constraints on that plant; `clearance` measures the
 smallest signed distance of a configuration for checking a path after it is planned.
 """
