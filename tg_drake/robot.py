@@ -59,20 +59,21 @@ IIWA_VELOCITY_LIMITS = np.array([j.velocity for j in IIWA_JOINTS])  # [rad/s], j
 IIWA_POSITION_LIMITS.flags.writeable = IIWA_VELOCITY_LIMITS.flags.writeable = False
 IIWA_FLANGE_Z = 0.045  # [m] the tool flange along link 7's z axis from link 7's frame.
 
-# A posture that keeps the arm clear of the camera's view of the table [rad], joints 1–7.
+# Our home posture: it keeps the arm clear of the camera's view of the table [rad], joints 1–7.
 IIWA_HOME = (0.0, -0.6, 0.0, -1.9, 0.0, 1.0, 0.0)
 
 # --- Schunk WSG 50 (Schunk's data sheet), in the gripper frame G --------------------------------
 
 WSG_BODY_SIZE = (0.146, 0.0725, 0.05)  # [m] the housing box along x_G, y_G, z_G.
-# [m] the housing box's centre in G: it spans y_G ∈ [−0.0575, 0.015], the fingers start at its
-# front.
+# [m] the housing box's centre in G, where the model puts it: the box spans y_G ∈ [−0.0575, 0.015],
+# the pads start at its front.
 WSG_BODY_CENTRE_G = (0.0, -0.0213, 0.0)
 WSG_BODY_MASS = 0.99  # [kg] the housing.
 WSG_FINGER_MASS = 0.05  # [kg] each finger.
 WSG_PAD_SIZE = (0.012, 0.082, 0.02)  # [m] a finger pad (with its tip): thickness along x_G, length
 # along the approach y_G, width along z_G.
-WSG_PAD_CENTRE_Y = 0.055  # [m] y_G of the pads' centres: the pads span y_G ∈ [0.014, 0.096].
+WSG_PAD_CENTRE_Y = 0.055  # [m] y_G of the pads' centres (the data sheet's grasp point, about
+# 0.055 m from the body origin along the fingers): the pads span y_G ∈ [0.014, 0.096].
 WSG_PALM_Y = WSG_PAD_CENTRE_Y - WSG_PAD_SIZE[1] / 2  # [m] 0.014: where the pads start.
 WSG_FINGERTIP_Y = WSG_PAD_CENTRE_Y + WSG_PAD_SIZE[1] / 2  # [m] 0.096: the pads' tips.
 # [m] the grasp point, between the pads' centres, in G: where the object should sit in the hand
