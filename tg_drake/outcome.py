@@ -10,8 +10,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# A finger opening below this means the fingers closed on air, whatever touches their outsides
-# (a bowl's wall, 4–5 mm thick, leaves the squeezing pads about 4 mm apart) [m].
+# The closed-on-air tolerance of every "held" check in tg_drake (the run's outcomes, the training
+# episodes' labels, the scripted grasp): a finger opening (distance between the pads' inner
+# faces) at or below this means the fingers closed on air, whatever touches their outsides [m].
+# Pads that close on nothing stop at 0 (each finger's joint limit; measured −0.03 mm in a grasp
+# episode); 1 mm is well above that and under the thinnest walls the library's objects offer the
+# pads (a pot's rim, 1–1.5 mm; a bowl's 4–5 mm wall leaves the squeezing pads about 4 mm apart).
 CLOSED_ON_AIR = 0.001
 # Placement tolerances: distance of the object's centre from the place target on the table [m],
 # tilt of its axis from the pose it was picked in [rad].

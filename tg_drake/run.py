@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from tg_drake.logic.theory import VARIANTS as THEORY_VARIANTS
+from tg_drake import robot
 from tg_drake.errors import (GraspingError, KernelError, PerceptionError, PlanningError,
                              RuleError, SimulationError, TgDrakeError)
 
@@ -284,10 +285,9 @@ def _write_images(folder: Path, station, context, pipeline, camera) -> None:
     save_scene_png(scene.objects, folder / "parts.png")
 
 
-# The open WSG's finger pads in G (models/wsg_50: 0.012 × 0.082 × 0.02 m boxes centred 0.055 m
-# along +y_G, inner faces at x = ±0.055) and its body box, for the grasp picture.
-_PADS_G = [((-0.061, 0.055, 0.0), (0.012, 0.082, 0.02)), ((0.061, 0.055, 0.0), (0.012, 0.082, 0.02))]
-_BODY_G = ((0.0, -0.0213, 0.0), (0.146, 0.0725, 0.05))
+# The open WSG's finger pads in G and its body box, for the grasp picture (tg_drake.robot).
+_PADS_G = robot.wsg_pad_boxes()
+_BODY_G = (robot.WSG_BODY_CENTRE_G, robot.WSG_BODY_SIZE)
 
 
 def _box_edges(X_WG: np.ndarray, centre, size) -> list[np.ndarray]:
@@ -318,7 +318,7 @@ def save_grasp_png(obj, X_WG: np.ndarray, path: Path, *, title: str = "") -> Pat
             ax.plot(*e.T, color="black", linewidth=1.2)
     for e in _box_edges(X_WG, *_BODY_G):
         ax.plot(*e.T, color="0.5", linewidth=0.8)
-    grasp_point = X_WG[:3, 3] + 0.055 * X_WG[:3, 1]
+    grasp_point = X_WG[:3, 3] + X_WG[:3, :3] @ robot.WSG_GRASP_POINT_G
     ax.quiver(*(grasp_point - 0.12 * X_WG[:3, 1]), *(0.08 * X_WG[:3, 1]), color="black")
     centre = obj.X_WO[:3, 3]
     half = max(0.5 * float(np.max(obj.extents)), 0.12)

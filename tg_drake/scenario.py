@@ -35,7 +35,8 @@ from tg_drake.kernels.database import KernelPriorConfig
 from tg_drake.logic.engine import LogicQueryConfig
 from tg_drake.perception.config import PerceptionConfig
 from tg_drake.planning.planner import PlannerConfig
-from tg_drake.robot import IIWA_HOME
+from tg_drake.robot import (IIWA_HOME, IIWA_JOINT_NAMES, WSG_FINGER_JOINTS, WSG_FORCE_LIMIT,
+                            WSG_OPEN_POSITIONS, X_7G_RPY, X_7G_XYZ)
 from tg_drake.schema_check import SchemaError, check_document, load_raw
 from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
 
@@ -44,10 +45,8 @@ from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
 # reach there (an IK sweep over grasp heights 0.04–0.25 m; see tools notes in the README).
 X_WT_DEFAULT = RigidTransform([0.75, 0.0, 0.0])
 
-# The WSG body frame G on the iiwa's link 7: 0.114 m out along the flange axis, the approach
-# direction +y_G along link 7's z axis (robot_facts.md: "mount").
-X_7G = RigidTransform(RollPitchYaw(np.pi / 2, 0, np.pi / 2), [0, 0, 0.114])
-
+# The WSG body frame G on the iiwa's link 7 (tg_drake.robot: the mount).
+X_7G = RigidTransform(RollPitchYaw(*X_7G_RPY), X_7G_XYZ)
 
 
 def _transform(X: RigidTransform, base_frame: str | None = None) -> Transform:
@@ -62,12 +61,12 @@ def default_directives() -> list[ModelDirective]:
     return [
         ModelDirective(add_model=AddModel(
             name="iiwa", file="package://tg_drake_models/iiwa14/iiwa14.urdf",
-            default_joint_positions={f"iiwa_joint_{i + 1}": [q] for i, q in enumerate(IIWA_HOME)})),
+            default_joint_positions={n: [q] for n, q in zip(IIWA_JOINT_NAMES, IIWA_HOME)})),
         ModelDirective(add_weld=AddWeld(parent="world", child="iiwa::iiwa_link_0")),
         ModelDirective(add_model=AddModel(
             name="wsg", file="package://tg_drake_models/wsg_50/wsg_50.sdf",
-            default_joint_positions={"left_finger_sliding_joint": [-0.055],
-                                     "right_finger_sliding_joint": [0.055]})),
+            default_joint_positions={n: [q] for n, q in zip(WSG_FINGER_JOINTS,
+                                                            WSG_OPEN_POSITIONS)})),
         ModelDirective(add_weld=AddWeld(parent="iiwa::iiwa_link_7", child="wsg::body",
                                         X_PC=_transform(X_7G))),
         ModelDirective(add_model=AddModel(
@@ -123,7 +122,7 @@ class WsgPdDriver:
 
     kp: float = 2000.0  # [N/m]
     kd: float = 50.0  # [N·s/m]
-    force_limit: float = 80.0  # [N] per finger: the WSG 50 drive's limit (robot_facts.md); at
+    force_limit: float = WSG_FORCE_LIMIT  # [N] per finger: the WSG 50 drive's limit; at
     # 40 N a 0.55 kg hammer held by its handle turned out of the pads while carried.
 
 

@@ -19,9 +19,11 @@ from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 from tg_drake.errors import PlanningError
+from tg_drake.outcome import CLOSED_ON_AIR
 from tg_drake.planning.ik import make_arm_plant, solve_ik
 from tg_drake.planning.planner import GRASP_DEPTH  # [m] the grasp point along +y_G
-from tg_drake.scenario import IIWA_HOME, Scenario
+from tg_drake.robot import IIWA_HOME, WSG_BODY, WSG_MAX_OPENING
+from tg_drake.scenario import Scenario
 from tg_drake.station import add_station, rotation_from_axes
 
 
@@ -79,8 +81,9 @@ def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: flo
     times = [0.0, 2.0, 3.0, 4.0, 5.5, 6.5]
     q_knots = np.column_stack([qs[0], qs[1], qs[2], qs[2], qs[3], qs[3]])
     q_traj = PiecewisePolynomial.FirstOrderHold(times, q_knots)
+    w_open = WSG_MAX_OPENING
     w_traj = PiecewisePolynomial.FirstOrderHold(
-        [0.0, 3.0, 3.8, times[-1]], np.array([[0.11, 0.11, width_closed, width_closed]]))
+        [0.0, 3.0, 3.8, times[-1]], np.array([[w_open, w_open, width_closed, width_closed]]))
     arm_source = builder.AddSystem(TrajectorySource(q_traj, output_derivative_order=1))
     wsg_source = builder.AddSystem(TrajectorySource(w_traj))
     builder.Connect(arm_source.get_output_port(), station.inputs["iiwa.desired_state"])
@@ -92,7 +95,7 @@ def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: flo
     plant_context = plant.GetMyMutableContextFromRoot(context)
     plant.SetPositions(plant_context, station.instances["iiwa"], qs[0])
     body = station.object_body(object_name)
-    G = plant.GetFrameByName("body", station.instances["wsg"])
+    G = plant.GetFrameByName(WSG_BODY, station.instances["wsg"])
 
     render_time = 0.0
     if render and station.cameras:
@@ -124,7 +127,7 @@ def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: flo
             surfaces += 1
     object_rise = X_WO.translation()[2] - z_obj_grasp
     gripper_rise = G.CalcPoseInWorld(plant_context).translation()[2] - z_g_grasp
-    held = bool(object_rise > 0.8 * gripper_rise and opening > 0.005)
+    held = bool(object_rise > 0.8 * gripper_rise and opening > CLOSED_ON_AIR)
     return GraspLiftResult(held, float(object_rise), float(gripper_rise), opening, surfaces,
                            times[-1], wall, render_time)
 

@@ -23,8 +23,6 @@ Station ports (as exported by `make_station`; `add_station` returns the same por
 
 from __future__ import annotations
 
-import functools
-import importlib.resources
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,23 +38,12 @@ from pydrake.systems.primitives import MatrixGain
 from pydrake.systems.sensors import CameraInfo, RgbdSensor
 
 from tg_drake.errors import ModelError, ScenarioError
+from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
+from tg_drake.robot_plants import add_scenario_models, make_parser
 from tg_drake.scenario import (InverseDynamicsDriver, JointPdDriver, ObjectPlacement, Scenario,
                                WsgPdDriver)
 
 WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container
-
-
-@functools.cache
-def models_root() -> str:
-    """The folder of the tg_drake_models package (models/ in the source tree)."""
-    return str(importlib.resources.files("tg_drake_models"))
-
-
-def make_parser(plant: MultibodyPlant) -> Parser:
-    """A parser that resolves package://tg_drake_models/... (and nothing from the internet)."""
-    parser = Parser(plant)
-    parser.package_map().AddPackageXml(f"{models_root()}/package.xml")
-    return parser
 
 
 def placement_pose(scenario: Scenario, placement: ObjectPlacement) -> RigidTransform:
@@ -264,13 +251,9 @@ def _add_inverse_dynamics(builder, scenario, plant, iiwa, driver):
     from pydrake.systems.controllers import InverseDynamicsController
 
     control_plant = Plant(time_step=0.0)
-    parser = make_parser(control_plant)
-    kept = [d for d in scenario.directives
-            if (d.add_model and d.add_model.name in ("iiwa", "wsg"))
-            or (d.add_weld and d.add_weld.child.split("::")[0] in ("iiwa", "wsg"))]
-    ProcessModelDirectives(ModelDirectives(directives=kept), parser)
+    add_scenario_models(control_plant, scenario, ("iiwa", "wsg"))
     wsg = control_plant.GetModelInstanceByName("wsg")
-    for joint in ("left_finger_sliding_joint", "right_finger_sliding_joint"):
+    for joint in WSG_FINGER_JOINTS:
         # The fingers' mass rides along as payload; their joints are locked for the controller.
         j = control_plant.GetJointByName(joint, wsg)
         parent, child = j.frame_on_parent(), j.frame_on_child()
@@ -324,7 +307,7 @@ def flange_pose(plant: MultibodyPlant, plant_context) -> RigidTransform:
 
 def gripper_pose(plant: MultibodyPlant, plant_context) -> RigidTransform:
     """X_WG: pose of the WSG body frame G."""
-    return plant.GetFrameByName("body", plant.GetModelInstanceByName("wsg")).CalcPoseInWorld(
+    return plant.GetFrameByName(WSG_BODY, plant.GetModelInstanceByName("wsg")).CalcPoseInWorld(
         plant_context)
 
 

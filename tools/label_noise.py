@@ -81,13 +81,14 @@ def episode_config(text: str | None) -> EpisodeConfig:
 
 def held_failures(records: list[dict], episode: EpisodeConfig) -> dict:
     """Recorded failures whose object nevertheless ended between both pads and off the table:
-    the label's finger-gap rule (`EpisodeConfig.min_finger_gap`, `min_finger_travel`) called
-    them failures."""
+    the label's finger-gap rule (`tg_drake.outcome.CLOSED_ON_AIR`,
+    `EpisodeConfig.min_finger_travel`) called them failures."""
     from tg_drake.grasping.dgi import MAX_OPENING
+    from tg_drake.outcome import CLOSED_ON_AIR
 
     ok = [r for r in records if r.get("status") == "ok"]
     rows = [r for r in ok if not r["success"] and held(r)]
-    closed = [r for r in rows if r["finger_gap"] <= episode.min_finger_gap]
+    closed = [r for r in rows if r["finger_gap"] <= CLOSED_ON_AIR]
     open_ = [r for r in rows if r["finger_gap"] >= MAX_OPENING - 2 * episode.min_finger_travel]
     by_category: dict[str, int] = defaultdict(int)
     for r in rows:

@@ -3,11 +3,11 @@
     python -m tools.make_robot_models          # (re)write models/iiwa14, models/wsg_50, models/table
     python -m tools.make_robot_models --check  # fail if the committed files differ from the output
 
-The figures (kinematics, limits, masses, inertias, collision cylinders; WSG 50 dimensions and
-stroke) are those of ../shared/robot_facts.md. Collision geometry is primitive (cylinders, spheres,
-boxes). The WSG finger pads and the table top carry compliant-hydroelastic properties; the settings
-are the ones measured to hold a grasp on this kind of machine (see robot_facts.md and the station
-module's docstring).
+The robots' figures (kinematics, limits; WSG 50 dimensions, stroke, force) are those of
+tg_drake.robot, the one source of them; the links' masses, inertias and collision primitives
+(cylinders, spheres, boxes) and the table are the model's own and live here. The WSG finger pads
+and the table top carry compliant-hydroelastic properties; the settings are the ones measured to
+hold a grasp on this kind of machine (see the station module's docstring).
 """
 
 from __future__ import annotations
@@ -18,26 +18,14 @@ import sys
 import tempfile
 from pathlib import Path
 
+from tg_drake.robot import (IIWA_FLANGE_Z, IIWA_JOINTS, WSG_BODY, WSG_BODY_CENTRE_G, WSG_BODY_MASS,
+                            WSG_BODY_SIZE, WSG_FINGER_JOINTS, WSG_FINGER_MASS, WSG_FINGER_VELOCITY,
+                            WSG_FINGERS, WSG_FORCE_LIMIT, WSG_PAD_CENTRE_Y, WSG_PAD_SIZE,
+                            WSG_STROKE)
+
 MODELS = Path(__file__).resolve().parents[1] / "models"
 
 PI = math.pi
-
-# KUKA LBR iiwa 14 R820. joint: (parent, child, xyz, rpy, limit [rad], velocity [rad/s], effort [N·m]).
-IIWA_JOINTS = [
-    ("iiwa_joint_1", "iiwa_link_0", "iiwa_link_1", (0, 0, 0.1575), (0, 0, 0), 2.96706, 1.48353, 320),
-    ("iiwa_joint_2", "iiwa_link_1", "iiwa_link_2", (0, 0, 0.2025), (PI / 2, 0, PI), 2.09440, 1.48353,
-     320),
-    ("iiwa_joint_3", "iiwa_link_2", "iiwa_link_3", (0, 0.2045, 0), (PI / 2, 0, PI), 2.96706, 1.74533,
-     176),
-    ("iiwa_joint_4", "iiwa_link_3", "iiwa_link_4", (0, 0, 0.2155), (PI / 2, 0, 0), 2.09440, 1.30900,
-     176),
-    ("iiwa_joint_5", "iiwa_link_4", "iiwa_link_5", (0, 0.1845, 0), (-PI / 2, PI, 0), 2.96706, 2.26893,
-     110),
-    ("iiwa_joint_6", "iiwa_link_5", "iiwa_link_6", (0, 0, 0.2155), (PI / 2, 0, 0), 2.09440, 2.35619,
-     40),
-    ("iiwa_joint_7", "iiwa_link_6", "iiwa_link_7", (0, 0.081, 0), (-PI / 2, PI, 0), 3.05433, 2.35619,
-     40),
-]
 
 # link: (mass [kg], com xyz, (Ixx, Iyy, Izz), collision (radius, length, centre xyz, rpy) or sphere).
 IIWA_LINKS = {
@@ -62,19 +50,9 @@ IIWA_LINKS = {
 IIWA_COLOR = {"iiwa_link_0": "0.4 0.4 0.4 1", "iiwa_link_7": "0.4 0.4 0.4 1"}
 IIWA_ORANGE = "1.0 0.42 0.04 1"
 
-# Schunk WSG 50 (robot_facts.md). Body frame G: fingers close along ±x, approach along +y.
-WSG_BODY_SIZE = (0.146, 0.0725, 0.05)  # x × y × z [m]
-WSG_BODY_MASS = 0.99  # [kg]
-WSG_BODY_CENTRE_Y = -0.0213  # body box spans y ∈ [-0.0575, 0.015]; fingers start at its front.
-WSG_FINGER_MASS = 0.05  # [kg]
-WSG_PAD_SIZE = (0.012, 0.082, 0.02)  # x (thickness) × y (length, along approach) × z [m]
-WSG_PAD_CENTRE_Y = 0.055  # pad spans y ∈ [0.014, 0.096]: grasp point 0.055 m from the body origin.
-WSG_STROKE = 0.055  # each finger 0 … 0.055 m from the centre: full opening 0.110 m.
-WSG_FORCE = 80.0  # [N] drive limit per finger.
-WSG_VELOCITY = 0.42  # [m/s] finger speed (WSG 50 data sheet: up to 420 mm/s).
 PAD_HYDRO = dict(modulus=1e6, resolution=0.005, dissipation=3.0, mu=1.0)
 
-# Table: a top slab on four legs. Compliant top (robot_facts.md).
+# Table: a top slab on four legs, its top compliant.
 TABLE_TOP_SIZE = (0.8, 1.2, 0.04)  # x (depth, away from the robot) × y (width) × z [m]
 TABLE_HEIGHT = 0.4  # [m] table-top surface above the floor.
 TABLE_HYDRO = dict(modulus=1e7, resolution=0.1, dissipation=3.0, mu=0.5)
@@ -120,7 +98,7 @@ def iiwa_urdf() -> str:
                    f'      <origin xyz="{_f(centre)}" rpy="{_f(rpy)}"/>\n'
                    f'      <geometry>{geometry}</geometry>\n    </collision>')
         out.append("  </link>")
-    # The tool flange: a frame 0.045 m above link 7 (a massless link on a fixed joint).
+    # The tool flange: a frame IIWA_FLANGE_Z above link 7 (a massless link on a fixed joint).
     out.append('  <link name="iiwa_link_ee"/>')
     for name, parent, child, xyz, rpy, limit, velocity, effort in IIWA_JOINTS:
         out.append(f'  <joint name="{name}" type="revolute">\n'
@@ -137,7 +115,7 @@ def iiwa_urdf() -> str:
                    '</actuator>\n  </transmission>')
     out.append('  <joint name="iiwa_joint_ee" type="fixed">\n'
                '    <parent link="iiwa_link_7"/>\n    <child link="iiwa_link_ee"/>\n'
-               '    <origin xyz="0 0 0.045" rpy="0 0 0"/>\n  </joint>')
+               f'    <origin xyz="0 0 {IIWA_FLANGE_Z}" rpy="0 0 0"/>\n  </joint>')
     # The coarse collision cylinders of links two apart overlap in normal postures; the real arm's
     # links do not collide there, so those pairs are filtered (groups of three consecutive links).
     links = list(IIWA_LINKS)
@@ -179,38 +157,41 @@ def wsg_sdf() -> str:
     bx, by, bz = WSG_BODY_SIZE
     px, py, pz = WSG_PAD_SIZE
     fingers = []
-    for side, sign, lower, upper in (("left", -1, -WSG_STROKE, 0.0), ("right", 1, 0.0, WSG_STROKE)):
+    for finger, joint, sign, lower, upper in zip(WSG_FINGERS, WSG_FINGER_JOINTS, (-1, 1),
+                                                 (-WSG_STROKE, 0.0), (0.0, WSG_STROKE)):
         # The finger frame moves with its joint; the pad's inner face sits at x = q (the joint value),
         # so the opening is q_right − q_left.
         pad_pose = f"{sign * px / 2:.6g} {WSG_PAD_CENTRE_Y} 0 0 0 0"
         fingers.append(
-            f'    <link name="{side}_finger">\n'
+            f'    <link name="{finger}">\n'
             + _sdf_inertial(WSG_FINGER_MASS, WSG_PAD_SIZE, pad_pose)
-            + f'      <visual name="{side}_finger_visual">\n        <pose>{pad_pose}</pose>\n'
+            + f'      <visual name="{finger}_visual">\n        <pose>{pad_pose}</pose>\n'
             f"        <geometry><box><size>{px} {py} {pz}</size></box></geometry>\n"
             "        <material><diffuse>0.2 0.2 0.2 1</diffuse></material>\n      </visual>\n"
-            f'      <collision name="{side}_finger_pad">\n        <pose>{pad_pose}</pose>\n'
+            f'      <collision name="{finger}_pad">\n        <pose>{pad_pose}</pose>\n'
             f"        <geometry><box><size>{px} {py} {pz}</size></box></geometry>\n"
             + _compliant(PAD_HYDRO)
             + "      </collision>\n    </link>\n"
-            f'    <joint name="{side}_finger_sliding_joint" type="prismatic">\n'
-            f"      <parent>body</parent>\n      <child>{side}_finger</child>\n"
+            f'    <joint name="{joint}" type="prismatic">\n'
+            f"      <parent>{WSG_BODY}</parent>\n      <child>{finger}</child>\n"
             "      <axis>\n        <xyz>1 0 0</xyz>\n"
             f"        <limit><lower>{lower}</lower><upper>{upper}</upper>"
-            f"<effort>{WSG_FORCE}</effort><velocity>{WSG_VELOCITY}</velocity></limit>\n"
+            f"<effort>{WSG_FORCE_LIMIT}</effort>"
+            f"<velocity>{WSG_FINGER_VELOCITY}</velocity></limit>\n"
             "        <dynamics><damping>0</damping></dynamics>\n      </axis>\n    </joint>\n")
-    body_pose = f"0 {WSG_BODY_CENTRE_Y} 0 0 0 0"
+    body_pose = f"{_f(WSG_BODY_CENTRE_G)} 0 0 0"
     return (
         '<?xml version="1.0"?>\n'
         "<!-- Schunk WSG 50 parallel gripper, written by tools/make_robot_models.py from\n"
         "     ../shared/robot_facts.md. Frame of `body` (G): fingers close along ±x, the approach\n"
-        "     direction is +y, the grasp point is 0.055 m along +y. Finger pads are plain boxes with\n"
+        f"     direction is +y, the grasp point is {WSG_PAD_CENTRE_Y} m along +y. Finger pads are "
+        "plain boxes with\n"
         "     compliant-hydroelastic properties. The two prismatic finger joints are the model's only\n"
         "     actuated joints (pydrake's SchunkWsgPositionController expects exactly that).\n"
         "     Do not edit by hand. -->\n"
         '<sdf version="1.9" xmlns:drake="http://drake.mit.edu">\n'
         '  <model name="wsg_50">\n'
-        '    <link name="body">\n'
+        f'    <link name="{WSG_BODY}">\n'
         + _sdf_inertial(WSG_BODY_MASS, WSG_BODY_SIZE, body_pose)
         + '      <visual name="body_visual">\n'
         f"        <pose>{body_pose}</pose>\n"

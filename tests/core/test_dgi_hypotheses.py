@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from tg_drake.errors import GraspingError
-from tg_drake.grasping.dgi import PAD_CENTER_Y, depth_images
+from tg_drake.grasping.dgi import FINGERTIP_Y, GRIPPER_BASE_Y, PAD_CENTER_Y, depth_images
 from tg_drake.grasping.hypotheses import (
     BODY_BOX,
     GRASP_INSET,
@@ -54,7 +54,7 @@ def test_two_grasps_per_face_approach_the_box_centre():
     # 4..15 of 7 mm from −0.070 m) see it at depth PAD_CENTER_Y − base = 0.041 m, the rest is
     # empty. 1e-12 m: the plate lies exactly in the grasp point's plane.
     expected = np.full((20, 3), -1.0)
-    expected[4:16] = PAD_CENTER_Y - 0.014
+    expected[4:16] = PAD_CENTER_Y - GRIPPER_BASE_Y
     np.testing.assert_allclose(di[0], expected, atol=1e-12)
     with pytest.raises(GraspingError, match="3 half extents"):
         box_grasps(X_WB, np.array([0.1, 0.1]))
@@ -106,7 +106,7 @@ def test_clears_plane_against_the_wsg_boxes():
     # Top-down grasp (approach −z_W): the lowest point is the open pads' tips at 0.096 m along y_G.
     X = np.eye(4)
     X[:3, :3] = np.column_stack([[1, 0, 0], [0, 0, -1], [0, 1, 0]])
-    X[2, 3] = 0.096 + 0.003 + 1e-6
+    X[2, 3] = FINGERTIP_Y + 0.003 + 1e-6
     assert clears_plane(X, 0.0, approach_distance=0.05)[0]
     X[2, 3] -= 2e-6
     assert not clears_plane(X, 0.0, approach_distance=0.05)[0]
@@ -124,12 +124,12 @@ def test_clears_plane_against_the_wsg_boxes():
 def test_retreat_lifts_grasps_on_flat_objects_just_above_the_table():
     top = np.eye(4)
     top[:3, :3] = np.column_stack([[1, 0, 0], [0, 0, -1], [0, 1, 0]])  # approach −z_W
-    top[2, 3] = 0.096 - 0.02  # fingertips 2 cm under the table top
+    top[2, 3] = FINGERTIP_Y - 0.02  # fingertips 2 cm under the table top
     side = np.eye(4)
     side[:3, :3] = np.column_stack([[0, 1, 0], [1, 0, 0], [0, 0, -1]])  # approach +x_W
     side[2, 3] = 0.01  # body bottom under the table: moving back along x does not help
     tilted = top.copy()
-    tilted[2, 3] = 0.096 - 0.06  # 6 cm under: more than max_retreat
+    tilted[2, 3] = FINGERTIP_Y - 0.06  # 6 cm under: more than max_retreat
     X, ok = retreat_above_plane(np.stack([top, side, tilted]), 0.0, approach_distance=0.05,
                                 clearance=0.003, max_retreat=0.05)
     np.testing.assert_array_equal(ok, [True, False, False])

@@ -21,6 +21,7 @@ from tg_drake.objects import (
     mesh,
     sample_surface,
 )
+from tg_drake.robot import WSG_MAX_OPENING, WSG_PAD_SIZE
 from tg_drake.types import CATEGORIES, PART_LABELS
 
 LIB = load_library()
@@ -45,9 +46,9 @@ MASS_RANGE = {
 DENSITY = {"ceramic": 2400.0, "glass": 2500.0, "steel": 7900.0, "aluminium": 2700.0,
            "cast_iron": 7200.0, "plastic": 1100.0, "pet": 1380.0}
 
-GRIPPER_OPENING = 0.11  # [m] WSG 50 full stroke.
+GRIPPER_OPENING = WSG_MAX_OPENING  # [m] WSG 50 full stroke.
 CLEARANCE = 0.005  # [m] per side, to slide the fingers around the part.
-FINGER_THICKNESS = 0.012  # [m] a pad (with tip) along the closing direction.
+FINGER_THICKNESS = WSG_PAD_SIZE[0]  # [m] a pad (with tip) along the closing direction.
 
 
 def mesh_volume(V, F):

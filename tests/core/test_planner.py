@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import GRASP_POINT, grasp_pose
 from pydrake.math import RigidTransform, RotationMatrix
 
 from tg_drake.planning.ik import (CONSTRAINT_TOLERANCE, clearance, make_arm_plant,
@@ -14,22 +15,11 @@ from tg_drake.planning.trajectory import IIWA_VELOCITY_LIMITS
 from tg_drake.scenario import IIWA_HOME
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, PartBox
 
-GRASP_POINT = 0.055  # [m] along +y_G from the WSG body origin (robot_facts.md)
 # The IK tolerances of PlannerConfig: 2 mm per axis (so up to 2·√3 mm), 0.02 rad; plus what the
 # accepted constraint violation (ik.CONSTRAINT_TOLERANCE, 1e-5) allows: 1e-5 m, and, on the
 # orientation constraint's cosine near 0.02 rad, 1e-5 / (2 sin 0.02) ≈ 2.5e-4 rad.
 IK_POSITION_ERROR = 2e-3 * np.sqrt(3) + 1e-5
 IK_ANGLE_ERROR = 0.02 + 3e-4
-
-
-def grasp_pose(p_W_grasp, approach_W, closing_W) -> np.ndarray:
-    """X_WG (4×4) with the grasp point at p_W_grasp, approach +y_G, fingers closing along x_G."""
-    y = np.asarray(approach_W, float) / np.linalg.norm(approach_W)
-    x = np.asarray(closing_W, float) / np.linalg.norm(closing_W)
-    X = np.eye(4)
-    X[:3, :3] = np.column_stack([x, y, np.cross(x, y)])
-    X[:3, 3] = np.asarray(p_W_grasp, float) - GRASP_POINT * y
-    return X
 
 
 def box_object(p_W_center, extents, parts=("bottom", "middle", "top")) -> ObjectDescription:
@@ -109,7 +99,7 @@ def test_pregrasp_into_the_box_is_refused_when_the_box_is_an_obstacle():
 
 def test_velocity_limits_are_the_robot_facts():
     arm = make_arm_plant()
-    # robot_facts.md, max velocity of joints 1–7 [rad/s].
+    # The KUKA data sheet's max velocity of joints 1–7 [rad/s].
     np.testing.assert_array_equal(IIWA_VELOCITY_LIMITS,
                                   [1.48353, 1.48353, 1.74533, 1.30900, 2.26893, 2.35619, 2.35619])
     np.testing.assert_allclose(arm.plant.GetVelocityUpperLimits()[arm.iiwa_indices],

@@ -11,6 +11,7 @@ import time
 
 import numpy as np
 import pytest
+from conftest import grasp_pose
 from pydrake.common.value import AbstractValue
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
@@ -23,19 +24,9 @@ from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.types import (PART_LABELS, GraspCandidates, ObjectDescription, PartBox,
                             SceneDescription)
 
-GRASP_POINT = 0.055  # [m] along +y_G from the WSG body origin (robot_facts.md)
 PLACE_XY = (0.75, -0.25)  # [m] world
 START = 0.1  # [s] first planning event
 OBJECT = "can_02"
-
-
-def grasp_pose(p_W_grasp, approach_W, closing_W) -> np.ndarray:
-    y = np.asarray(approach_W, float)
-    x = np.asarray(closing_W, float)
-    X = np.eye(4)
-    X[:3, :3] = np.column_stack([x, y, np.cross(x, y)])
-    X[:3, 3] = np.asarray(p_W_grasp, float) - GRASP_POINT * y
-    return X
 
 
 def ground_truth_description(scenario: Scenario) -> ObjectDescription:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import grasp_pose
 from pydrake.common.value import AbstractValue
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
@@ -14,18 +15,8 @@ from tg_drake.systems.grasp_planner import GraspPlanner, PlanStatus
 from tg_drake.types import (PART_LABELS, GraspCandidates, ObjectDescription, PartBox,
                             SceneDescription)
 
-GRASP_POINT = 0.055  # [m] along +y_G from the WSG body origin (robot_facts.md)
 START = 0.5  # [s] the planner's first event
 Q_MEASURED = np.array([0.1, -0.5, 0.05, -1.8, 0.0, 1.1, 0.2])  # a posture near IIWA_HOME
-
-
-def grasp_pose(p_W_grasp, approach_W, closing_W) -> np.ndarray:
-    y = np.asarray(approach_W, float)
-    x = np.asarray(closing_W, float)
-    X = np.eye(4)
-    X[:3, :3] = np.column_stack([x, y, np.cross(x, y)])
-    X[:3, 3] = np.asarray(p_W_grasp, float) - GRASP_POINT * y
-    return X
 
 
 def scene_with_box(p_W_center, extents=(0.07, 0.07, 0.20)) -> SceneDescription:

@@ -17,8 +17,8 @@ Everything is vectorised over many hypotheses (M gripper poses) and points (N): 
 over points or poses.
 
 Gripper frame G is the WSG body frame of models/wsg_50/wsg_50.sdf: the fingers close along ±x_G,
-the approach direction is +y_G, z_G is across the finger pads. The constants below are the pads'
-geometry in that file (a test checks that they still agree with it).
+the approach direction is +y_G, z_G is across the finger pads. The pads' geometry below comes from
+tg_drake.robot, which the model file is written from (a test checks that they still agree).
 
 The paper names its cells "7x7x15 (mm)" without tying the third figure to an axis. Here a cell is
 7 mm along x_G (u) by 7 mm along z_G (v) and spans the whole depth of the closing volume, since DI
@@ -32,16 +32,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from tg_drake.errors import GraspingError
+from tg_drake.robot import (WSG_FINGERTIP_Y, WSG_MAX_OPENING, WSG_PAD_CENTRE_Y, WSG_PAD_SIZE,
+                            WSG_PALM_Y)
 
-# --- WSG 50 geometry in the gripper frame G [m] (models/wsg_50/wsg_50.sdf) ---------------------
+# --- WSG 50 geometry in the gripper frame G [m] (tg_drake.robot) -------------------------------
 CLOSING_AXIS = 0  # index of x_G: the fingers close along ±x_G.
 APPROACH_AXIS = 1  # index of y_G: the gripper approaches the object along +y_G.
 PAD_WIDTH_AXIS = 2  # index of z_G: across the finger pads.
-MAX_OPENING = 0.110  # distance between the pads' inner faces when fully open.
-PAD_SIZE = (0.012, 0.082, 0.020)  # finger pad box along x_G, y_G, z_G.
-PAD_CENTER_Y = 0.055  # y_G of the pads' centres (the grasp point).
-GRIPPER_BASE_Y = PAD_CENTER_Y - PAD_SIZE[1] / 2  # 0.014: the palm, where the pads start.
-FINGERTIP_Y = PAD_CENTER_Y + PAD_SIZE[1] / 2  # 0.096: the pads' tips.
+MAX_OPENING = WSG_MAX_OPENING  # distance between the pads' inner faces when fully open.
+PAD_SIZE = WSG_PAD_SIZE  # finger pad box along x_G, y_G, z_G.
+PAD_CENTER_Y = WSG_PAD_CENTRE_Y  # y_G of the pads' centres (the grasp point).
+GRIPPER_BASE_Y = WSG_PALM_Y  # 0.014: the palm, where the pads start.
+FINGERTIP_Y = WSG_FINGERTIP_Y  # 0.096: the pads' tips.
 
 # --- DGI sampling (paper: 7 mm cells) -----------------------------------------------------------
 CELL_SIZE = 0.007  # pixel side across the approach axis [m] (paper).

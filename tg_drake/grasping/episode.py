@@ -23,11 +23,12 @@ An episode (all times in seconds, `EpisodeConfig`):
    pads), `shake_cycles` times, under a sin² envelope so that it starts and stops at rest.
 
 Label: success when at the end the object is held between the fingers: the fingers closed onto
-something (their gap ended between `min_finger_gap` and the full opening less `min_finger_travel`
-on each side — fingers that never moved cannot hold anything, even if pressing their tips on a
-face carried the object up) and the object no longer touches the table. A run whose physics fails
-(solver error, NaN, the object falling through the table or flying off) is reported with status
-"sim_error" and its reason instead of a label.
+something (their gap ended above `tg_drake.outcome.CLOSED_ON_AIR`, the run's rule for fingers that
+closed on air, and below the full opening less `min_finger_travel` on each side — fingers that
+never moved cannot hold anything, even if pressing their tips on a face carried the object up)
+and the object no longer touches the table. A run whose physics fails (solver error, NaN, the
+object falling through the table or flying off) is reported with status "sim_error" and its reason
+instead of a label.
 """
 
 from __future__ import annotations
@@ -54,9 +55,11 @@ from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem
 
 from tg_drake.errors import SimulationError
 from tg_drake.grasping.dgi import MAX_OPENING
+from tg_drake.outcome import CLOSED_ON_AIR
+from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS, WSG_FINGERS
 
 TABLE_TOP_Z = 0.0  # the table's top surface in the world [m] (table_top frame welded at W).
-FINGER_JOINTS = ("left_finger_sliding_joint", "right_finger_sliding_joint")
+FINGER_JOINTS = WSG_FINGER_JOINTS
 CARRIER_JOINTS = ("carrier_x", "carrier_y", "carrier_z", "carrier_rx", "carrier_ry", "carrier_rz")
 
 
@@ -83,7 +86,6 @@ class EpisodeConfig:
     carrier_kd_rotation: float = 20.0  # [N·m·s/rad]
     carrier_force_limit: float = 150.0  # [N] per translation joint: an arm pushes no harder.
     carrier_torque_limit: float = 15.0  # [N·m] per rotation joint.
-    min_finger_gap: float = 0.002  # fingers closer than this closed on nothing [m].
     min_finger_travel: float = 0.005  # each finger must have closed at least this much [m].
     object_mass: float = 0.0  # > 0: the object's inertia scaled to this mass [kg] (same shape and
     # centre of mass): labels that do not depend on how heavy the object is.
@@ -217,7 +219,7 @@ class GraspWorld:
                 child_body = plant.AddRigidBody(f"{name}_link", wsg, _carrier_inertia())
                 child = child_body.body_frame()
             else:
-                child = plant.GetFrameByName("body", wsg)
+                child = plant.GetFrameByName(WSG_BODY, wsg)
             joint_type = PrismaticJoint if k < 3 else RevoluteJoint
             joint = plant.AddJoint(joint_type(name, parent, child, axes[k % 3]))
             actuator = plant.AddJointActuator(
@@ -247,8 +249,8 @@ class GraspWorld:
                          (plant.get_body(BodyIndex(i)) for i in range(plant.num_bodies()))
                          for g in plant.GetCollisionGeometriesForBody(body)}
         self._named_bodies = {"table": plant.GetBodyByName("table_top", table).index(),
-                              "left_pad": plant.GetBodyByName("left_finger", wsg).index(),
-                              "right_pad": plant.GetBodyByName("right_finger", wsg).index()}
+                              "left_pad": plant.GetBodyByName(WSG_FINGERS[0], wsg).index(),
+                              "right_pad": plant.GetBodyByName(WSG_FINGERS[1], wsg).index()}
         self.simulator = Simulator(self.diagram)
         self.context = self.simulator.get_mutable_context()
         self._default_state = self.context.get_discrete_state_vector().CopyToVector()
@@ -300,7 +302,7 @@ class GraspWorld:
                 - self.fingers[0].get_translation(plant_context)
             X_WO_end = self.plant.EvalBodyPoseInWorld(plant_context, self.object_body)
             touching = self._object_contacts(plant_context)
-            closed_on_it = c.min_finger_gap < gap < MAX_OPENING - 2 * c.min_finger_travel
+            closed_on_it = CLOSED_ON_AIR < gap < MAX_OPENING - 2 * c.min_finger_travel
             result.update(
                 success=bool(closed_on_it and not touching["table"]),
                 finger_gap=float(gap),

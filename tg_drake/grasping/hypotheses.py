@@ -19,13 +19,12 @@ from __future__ import annotations
 import numpy as np
 
 from tg_drake.errors import GraspingError
-from tg_drake.grasping.dgi import MAX_OPENING, PAD_CENTER_Y, PAD_SIZE
+from tg_drake.grasping.dgi import PAD_CENTER_Y
+from tg_drake.robot import WSG_BODY_CENTRE_G, WSG_BODY_SIZE, wsg_pad_boxes
 
-# Collision boxes of models/wsg_50/wsg_50.sdf in G, fingers fully open: (centre, full size) [m].
-BODY_BOX = (np.array([0.0, -0.0213, 0.0]), np.array([0.146, 0.0725, 0.05]))
-PAD_BOXES = tuple(
-    (np.array([s * (MAX_OPENING / 2 + PAD_SIZE[0] / 2), PAD_CENTER_Y, 0.0]), np.array(PAD_SIZE))
-    for s in (-1.0, 1.0))
+# Collision boxes of the WSG in G, fingers fully open: (centre, full size) [m].
+BODY_BOX = (np.array(WSG_BODY_CENTRE_G), np.array(WSG_BODY_SIZE))
+PAD_BOXES = wsg_pad_boxes()
 # How far behind the face the grasp point goes on a part thicker than the pads reach [m]:
 # the pads then overlap the part by 0.041 + 0.025 = 66 mm of their 82 mm length.
 GRASP_INSET = 0.025

@@ -17,10 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from tg_drake.perception.config import PregraspConfig
-
-# The grasp point (between the fingertips) in the WSG body frame G [m]: 0.055 m along +y_G, the
-# approach direction. Change it here if the gripper model changes.
-WSG_GRASP_POINT_G = np.array([0.0, 0.055, 0.0])
+from tg_drake.robot import WSG_GRASP_POINT_G  # the grasp point in G [m]: 0.055 m along +y_G
 
 # Face i (0..5) of a box: outward normal along box axis FACE_AXIS[i] with sign FACE_SIGN[i].
 FACE_AXIS = np.array([0, 0, 1, 1, 2, 2])

@@ -1,8 +1,9 @@
 """Inverse kinematics for the iiwa + WSG: joint positions that put the gripper frame G at a pose.
 
 The arm model for planning is a separate plant (`make_arm_plant`): the iiwa, the WSG welded to its
-flange with its fingers fixed open, the table, optional obstacles (boxes) welded where the
-perceived objects are, and optionally a held object (a box welded to the gripper frame G).
+flange with its fingers fixed open, the table (those models of the scenario's directives, through
+`tg_drake.robot_plants`), optional obstacles (boxes) welded where the perceived objects are, and
+optionally a held object (a box welded to the gripper frame G).
 Collision avoidance uses minimum-distance constraints on that plant; `clearance` measures the
 smallest signed distance of a configuration for checking a path after it is planned.
 """
@@ -10,18 +11,26 @@ smallest signed distance of a configuration for checking a path after it is plan
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pydrake.geometry import Box, Cylinder, CollisionFilterDeclaration, GeometrySet
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.inverse_kinematics import InverseKinematics
-from pydrake.multibody.parsing import ModelDirectives, ProcessModelDirectives
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction
 from pydrake.multibody.tree import SpatialInertia
 from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 from pydrake.systems.framework import DiagramBuilder
 
-from tg_drake.robot import IIWA_HOME
+from tg_drake.robot import (IIWA_HOME, IIWA_JOINT_NAMES, WSG_BODY, WSG_FINGER_JOINTS, WSG_FINGERS,
+                            WSG_MAX_OPENING)
+
+if TYPE_CHECKING:
+    from tg_drake.scenario import Scenario
+
+# The scenario's models in the planning plant: the robot, the gripper and the table; loose objects
+# become obstacles if at all.
+PLANNING_MODELS = ("iiwa", "wsg", "table")
 
 
 # Weight of the IK's pull towards its seed [1/rad²]: a preference among the solutions that meet
@@ -49,8 +58,9 @@ class ArmPlant:
         return q
 
 
-def make_arm_plant(scenario=None, *, obstacles=(),
-                   finger_opening: float = 0.11, held=None, finger_contact=()) -> ArmPlant:
+def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
+                   finger_opening: float = WSG_MAX_OPENING, held=None,
+                   finger_contact=()) -> ArmPlant:
     """A kinematic model of the arm for IK and collision checking.
 
     obstacles: iterable of (name, X_WB RigidTransform, size) welded to the world: a box when size
@@ -62,22 +72,13 @@ def make_arm_plant(scenario=None, *, obstacles=(),
         or released: its box is a bounding box, and the fingers close on the object inside it);
         the rest of the arm and gripper still keeps clear of them.
     """
-    from tg_drake.station import make_parser
+    # The scenario schema composes the planner's config, which imports this module: the builder
+    # of the scenario's models (which reads the schema) is imported when a plant is made.
+    from tg_drake.robot_plants import add_scenario_models
 
-    # The scenario schema composes the planner's config, which imports this module: import the
-    # schema when an arm plant is made, not when this module loads.
-    from tg_drake.scenario import Scenario, default_directives
-
-    scenario = scenario or Scenario()
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    parser = make_parser(plant)
-    # Only the robot, the gripper and the table; loose objects become obstacles if at all.
-    kept = {"iiwa", "wsg", "table"}
-    directives = [d for d in (scenario.directives or default_directives())
-                  if (d.add_model and d.add_model.name in kept)
-                  or (d.add_weld and d.add_weld.child.split("::")[0] in kept)]
-    ProcessModelDirectives(ModelDirectives(directives=directives), parser)
+    add_scenario_models(plant, scenario, PLANNING_MODELS)
     # Fix the fingers at the given opening: weld-like by locking their joints in IK (bounds).
     world = plant.world_body()
     added = []
@@ -106,7 +107,7 @@ def make_arm_plant(scenario=None, *, obstacles=(),
                                        SpatialInertia.SolidBoxWithMass(1.0, *size))
         plant.RegisterCollisionGeometry(held_body, RigidTransform(), Box(*size), "held_object",
                                         CoulombFriction(0.5, 0.5))
-        plant.WeldFrames(plant.GetFrameByName("body", plant.GetModelInstanceByName("wsg")),
+        plant.WeldFrames(plant.GetFrameByName(WSG_BODY, plant.GetModelInstanceByName("wsg")),
                          held_body.body_frame(), X_GO)
     plant.Finalize()
     # The gripper's own bodies never collide with each other or with link 7 (they are attached).
@@ -121,7 +122,7 @@ def make_arm_plant(scenario=None, *, obstacles=(),
         + (list(plant.GetCollisionGeometriesForBody(held_body)) if held_body else []))
     manager.Apply(CollisionFilterDeclaration().ExcludeWithin(gripper_geometries))
     if touchable:
-        fingers = GeometrySet([g for n in ("left_finger", "right_finger")
+        fingers = GeometrySet([g for n in WSG_FINGERS
                                for g in plant.GetCollisionGeometriesForBody(
                                    plant.GetBodyByName(n, wsg))])
         objects = GeometrySet([g for b in touchable
@@ -131,9 +132,9 @@ def make_arm_plant(scenario=None, *, obstacles=(),
     context = diagram.CreateDefaultContext()
     plant_context = plant.GetMyMutableContextFromRoot(context)
     plant.SetPositions(plant_context, wsg, [-finger_opening / 2, finger_opening / 2])
-    G = plant.GetFrameByName("body", wsg)
-    iiwa_indices = np.array([plant.GetJointByName(f"iiwa_joint_{k + 1}", iiwa).position_start()
-                             for k in range(7)])
+    G = plant.GetFrameByName(WSG_BODY, wsg)
+    iiwa_indices = np.array([plant.GetJointByName(n, iiwa).position_start()
+                             for n in IIWA_JOINT_NAMES])
     return ArmPlant(diagram, plant, scene_graph, context, plant_context, G, iiwa, added,
                     iiwa_indices, plant.GetPositions(plant_context).copy())
 
@@ -181,13 +182,11 @@ def solve_ik(arm: ArmPlant, X_WG: RigidTransform, *, q_seed=IIWA_HOME,
     # The fingers stay where the arm plant holds them.
     wsg = plant.GetModelInstanceByName("wsg")
     q_all = plant.GetPositions(arm.plant_context)
-    fingers = [plant.GetJointByName(n, wsg).position_start()
-               for n in ("left_finger_sliding_joint", "right_finger_sliding_joint")]
+    fingers = [plant.GetJointByName(n, wsg).position_start() for n in WSG_FINGER_JOINTS]
     prog = ik.prog()
     for i in fingers:
         prog.AddBoundingBoxConstraint(q_all[i], q_all[i], q[i])
-    iiwa_idx = [plant.GetJointByName(f"iiwa_joint_{k + 1}", arm.iiwa).position_start()
-                for k in range(7)]
+    iiwa_idx = [plant.GetJointByName(n, arm.iiwa).position_start() for n in IIWA_JOINT_NAMES]
     q_nominal = q_all.copy()
     q_nominal[iiwa_idx] = q_seed if q_guess is None else q_guess
     prog.AddQuadraticErrorCost(np.eye(len(iiwa_idx)) * IK_SEED_WEIGHT, np.asarray(q_seed),

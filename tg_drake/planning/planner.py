@@ -49,8 +49,8 @@ from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.trajectory import (SegmentConfig, SegmentLimits, StraightLine,
                                           plan_segment, shifted)
-from tg_drake.perception.pregrasp import WSG_GRASP_POINT_G
-from tg_drake.robot import IIWA_HOME
+from tg_drake.robot import (IIWA_HOME, WSG_FINGERTIP_Y, WSG_GRASP_POINT_G, WSG_MAX_OPENING,
+                            WSG_PAD_SIZE, WSG_PALM_Y)
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, SceneDescription
 
 
@@ -62,7 +62,7 @@ class PlannerConfig:
     lift_height: float = 0.15  # [m] lift (and pre-place height above the place pose).
     retreat_distance: float = 0.10  # [m] after release, back along −y_G.
     release_height: float = 0.01  # [m] gap under the object's box at the place pose.
-    open_width: float = 0.11  # [m] WSG opening while moving (its full stroke).
+    open_width: float = WSG_MAX_OPENING  # [m] WSG opening while moving (its full stroke).
     closed_width: float = -0.04  # [m] commanded to grasp, past closed: each finger's P term
     # (kp 2000 N/m × (w/2 + 20 mm) on an object w wide) grips with 40 N + 1000 N/m · w, up to the
     # WSG driver's force limit (80 N from w = 40 mm). Commanding 0 gave a 25 mm hammer handle only
@@ -388,10 +388,11 @@ def _place_variants(X_WO_place: np.ndarray, config: PlannerConfig) -> list[np.nd
     return out
 
 
-# The open finger pads in G (tools/make_robot_models.py: pads 0.012 × 0.082 × 0.02 m centred
-# 0.055 m along +y_G, inner faces at x = ±0.055 when open): the 8 corners of the pair [m].
-PAD_CORNERS_G = np.array([[sx * x, y, sz * 0.01] for sx in (-1, 1) for x in (0.067,)
-                          for y in (0.014, 0.096) for sz in (-1, 1)])
+# The open finger pads in G (tg_drake.robot: pads 0.012 × 0.082 × 0.02 m centred 0.055 m along
+# +y_G, inner faces at x = ±0.055 when open): the 8 outer corners of the pair [m].
+PAD_CORNERS_G = np.array([[sx * x, y, sz * WSG_PAD_SIZE[2] / 2] for sx in (-1, 1)
+                          for x in (WSG_MAX_OPENING / 2 + WSG_PAD_SIZE[0],)
+                          for y in (WSG_PALM_Y, WSG_FINGERTIP_Y) for sz in (-1, 1)])
 TABLE_CLEARANCE = 0.004  # [m] the open pads' lowest corner above the table top
 
 
@@ -689,7 +690,8 @@ def _pad_area_below_middle(target: ObjectDescription, X_WG: np.ndarray, open_wid
     return float(below.sum() * cell ** 2)
 
 
-PAD_THICKNESS = 0.012  # [m] the pads' thickness along x_G, outwards from their inner faces
+# [m] the pads' thickness along x_G, outwards from their inner faces
+PAD_THICKNESS = WSG_PAD_SIZE[0]
 PAD_CELL = 0.004  # [m] cells of a pad's 12 × 20 mm cross-section (3 × 5), perception's voxel
 
 

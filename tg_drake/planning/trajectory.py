@@ -37,10 +37,7 @@ from pydrake.solvers import Solve
 from pydrake.trajectories import BsplineTrajectory
 
 from tg_drake.planning.ik import ArmPlant, clearance, satisfies_constraints
-
-# The iiwa 14's joint velocity limits [rad/s] (robot_facts.md, joints 1–7). The arm plant's URDF
-# carries the same numbers; a test checks that they agree.
-IIWA_VELOCITY_LIMITS = np.array([1.48353, 1.48353, 1.74533, 1.30900, 2.26893, 2.35619, 2.35619])
+from tg_drake.robot import IIWA_VELOCITY_LIMITS  # [rad/s], joints 1–7 (the models' too)
 
 
 @dataclass
