@@ -30,6 +30,7 @@ from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.sensors import CameraConfig
 
 from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.table import TABLE_SIZE, table_size_problem
 from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 # Where the table-top frame T sits in the world (its surface at the iiwa base height). Its centre
@@ -53,7 +54,8 @@ def _transform(X: RigidTransform, base_frame: str | None = None) -> Transform:
 
 
 def default_directives() -> list[ModelDirective]:
-    """The station: the iiwa on the floor at the world origin, the WSG on its flange, the table."""
+    """The robot: the iiwa on the floor at the world origin, the WSG on its flange. (The table is
+    not a directive: the station adds it from `table_size` and `X_WT`, tg_drake.table.)"""
     return [
         ModelDirective(add_model=AddModel(
             name="iiwa", file="package://tg_drake_models/iiwa14/iiwa14.urdf",
@@ -65,10 +67,6 @@ def default_directives() -> list[ModelDirective]:
                                      "right_finger_sliding_joint": [0.055]})),
         ModelDirective(add_weld=AddWeld(parent="iiwa::iiwa_link_7", child="wsg::body",
                                         X_PC=_transform(X_7G))),
-        ModelDirective(add_model=AddModel(
-            name="table", file="package://tg_drake_models/table/table.sdf")),
-        ModelDirective(add_weld=AddWeld(parent="world", child="table::table_top",
-                                        X_PC=_transform(X_WT_DEFAULT))),
     ]
 
 
@@ -237,8 +235,9 @@ class Scenario:
     objects: list[ObjectPlacement] = field(default_factory=list)
     task: TaskConfig = field(default_factory=TaskConfig)
     pipeline: PipelineConfig = field(default_factory=PipelineConfig)
-    # Table-top size (x, y) [m] used to check that objects stand on it.
-    table_size: list[float] = field(default_factory=lambda: [0.8, 1.2])
+    # The table: its top's size (x, y) [m] and where its top frame T sits in the world. The station
+    # builds the table from these (tg_drake.table); objects must stand within the top.
+    table_size: list[float] = field(default_factory=lambda: list(TABLE_SIZE))
     X_WT: Transform = field(default_factory=lambda: _transform(X_WT_DEFAULT))
 
     def target_placement(self) -> ObjectPlacement:
@@ -293,6 +292,9 @@ def _tidy_yaml_error(message: str) -> str:
 def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
     """Checks names and geometry that YAML typing alone cannot."""
     names = set()
+    problem = table_size_problem(scenario.table_size)
+    if problem:
+        raise ScenarioError(problem, file=where, field="table_size")
     half = np.asarray(scenario.table_size) / 2
     for i, placement in enumerate(scenario.objects):
         f = f"objects[{i}]"

@@ -47,6 +47,7 @@ from pydrake.systems.sensors import ApplyCameraConfig, CameraConfig, CameraInfo,
 from tg_drake.errors import ModelError, ScenarioError, unknown_name
 from tg_drake.scenario import (InverseDynamicsDriver, JointPdDriver, ObjectPlacement, Scenario,
                                WsgPdDriver)
+from tg_drake.table import add_table
 
 WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container
 NO_LCM = "memq://null"  # the LCM URL that publishes nothing: the station sends no messages
@@ -179,16 +180,24 @@ def _add_contents(plant: MultibodyPlant, instance, body, obj) -> None:
 
 def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
     """Adds the plant, scene graph, drivers and cameras of `scenario` to `builder`."""
+    _check_renderers(scenario)
     # Plant and scene graph, hydroelastic contact with SAP.
     plant, scene_graph = AddMultibodyPlant(scenario.plant_config, builder)
     parser = make_parser(plant)
 
-    # Robot, gripper, table from the directives; library objects from the `objects` block.
+    # Robot and gripper from the directives, the table from table_size and X_WT; library objects
+    # from the `objects` block.
     try:
         added = ProcessModelDirectives(ModelDirectives(directives=scenario.directives), parser)
     except RuntimeError as e:
         raise ModelError(f"could not load the scenario's directives: {e}") from None
     instances = {plant.GetModelInstanceName(i.model_instance): i.model_instance for i in added}
+    if plant.HasModelInstanceNamed("table"):
+        raise ScenarioError("the directives add a model named 'table'; the station adds the table "
+                            "itself, from table_size and X_WT: remove that directive",
+                            field="directives")
+    X_WT = scenario.X_WT.GetDeterministicValue()
+    instances["table"] = add_table(plant, scenario.table_size, X_WT)
     objects = _add_objects(scenario, plant, parser)
     instances.update(objects)
 
@@ -236,7 +245,6 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
 
     # Cameras: Drake's ApplyCameraConfig adds each RgbdSensor (and its renderer, by the config's
     # renderer_name and renderer_class); a sensor renders only when an image port is asked.
-    _check_renderers(scenario)
     for name, config in scenario.cameras.items():
         _add_camera(builder, station, name, config)
     return station
@@ -280,8 +288,9 @@ def _check_renderers(scenario: Scenario) -> None:
                                 f"({_gl_unavailable()}); allowed here: {', '.join(usable)}",
                                 field=where)
         if engine == "RenderEngineGltfClient":
-            raise ScenarioError("RenderEngineGltfClient renders on a glTF server, which the station "
-                                f"does not run; allowed here: {', '.join(usable)}", field=where)
+            raise ScenarioError("RenderEngineGltfClient renders on a glTF server, which the "
+                                f"station does not run; allowed here: {', '.join(usable)}",
+                                field=where)
         if engine not in RENDERER_CLASSES:
             raise unknown_name("renderer class", engine, usable, error=ScenarioError,
                                field=where)

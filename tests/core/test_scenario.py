@@ -18,7 +18,9 @@ def test_missing_keys_keep_defaults(tmp_path):
     assert scenario.plant_config.contact_model == "hydroelastic_with_fallback"
     assert scenario.plant_config.discrete_contact_approximation == "sap"
     assert isinstance(scenario.model_drivers["iiwa"], JointPdDriver)
-    assert [d.add_model.name for d in scenario.directives if d.add_model] == ["iiwa", "wsg", "table"]
+    # The table is not a directive: the station builds it from table_size and X_WT.
+    assert [d.add_model.name for d in scenario.directives if d.add_model] == ["iiwa", "wsg"]
+    assert scenario.table_size == [0.8, 1.2]
 
 
 def test_tagged_driver_union_is_chosen_in_yaml(tmp_path):

@@ -22,6 +22,7 @@ from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 from pydrake.systems.framework import DiagramBuilder
 
 from tg_drake.scenario import IIWA_HOME, Scenario, default_directives
+from tg_drake.table import add_table
 
 
 # Weight of the IK's pull towards its seed [1/rad²]: a preference among the solutions that meet
@@ -69,11 +70,12 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     parser = make_parser(plant)
     # Only the robot, the gripper and the table; loose objects become obstacles if at all.
-    kept = {"iiwa", "wsg", "table"}
+    kept = {"iiwa", "wsg"}
     directives = [d for d in (scenario.directives or default_directives())
                   if (d.add_model and d.add_model.name in kept)
                   or (d.add_weld and d.add_weld.child.split("::")[0] in kept)]
     ProcessModelDirectives(ModelDirectives(directives=directives), parser)
+    add_table(plant, scenario.table_size, scenario.X_WT.GetDeterministicValue())
     # Fix the fingers at the given opening: weld-like by locking their joints in IK (bounds).
     world = plant.world_body()
     added = []
