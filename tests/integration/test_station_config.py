@@ -166,3 +166,11 @@ def test_the_planning_plant_has_the_scenario_table():
     geometry = _table_geometry(arm.plant, arm.scene_graph, Role.kProximity)
     (top,) = geometry.values()
     np.testing.assert_allclose(_box(top[0]), [0.6, 0.9, 0.04])
+
+
+def test_a_table_directive_is_a_clear_error():
+    text = ("directives:\n"
+            "  - add_model: {name: table, file: package://tg_drake_models/table/table.sdf}\n")
+    with pytest.raises(ScenarioError, match="the station adds the table itself") as e:
+        make_station(_scenario(text))
+    assert e.value.field == "directives"
