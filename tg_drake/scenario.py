@@ -38,6 +38,7 @@ from tg_drake.planning.planner import PlannerConfig
 from tg_drake.robot import (IIWA_HOME, IIWA_JOINT_NAMES, WSG_FINGER_JOINTS, WSG_FORCE_LIMIT,
                             WSG_OPEN_POSITIONS, X_7G_RPY, X_7G_XYZ)
 from tg_drake.schema_check import SchemaError, check_document, load_raw
+from tg_drake.table import TABLE_SIZE, table_size_problem
 from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 # Where the table-top frame T sits in the world (its surface at the iiwa base height). Its centre
@@ -57,7 +58,8 @@ def _transform(X: RigidTransform, base_frame: str | None = None) -> Transform:
 
 
 def default_directives() -> list[ModelDirective]:
-    """The station: the iiwa on the floor at the world origin, the WSG on its flange, the table."""
+    """The robot: the iiwa on the floor at the world origin, the WSG on its flange. (The table is
+    not a directive: the station adds it from `table_size` and `X_WT`, tg_drake.table.)"""
     return [
         ModelDirective(add_model=AddModel(
             name="iiwa", file="package://tg_drake_models/iiwa14/iiwa14.urdf",
@@ -69,10 +71,6 @@ def default_directives() -> list[ModelDirective]:
                                                             WSG_OPEN_POSITIONS)})),
         ModelDirective(add_weld=AddWeld(parent="iiwa::iiwa_link_7", child="wsg::body",
                                         X_PC=_transform(X_7G))),
-        ModelDirective(add_model=AddModel(
-            name="table", file="package://tg_drake_models/table/table.sdf")),
-        ModelDirective(add_weld=AddWeld(parent="world", child="table::table_top",
-                                        X_PC=_transform(X_WT_DEFAULT))),
     ]
 
 
@@ -313,8 +311,9 @@ class Scenario:
     objects: list[ObjectPlacement] = field(default_factory=list)
     task: TaskConfig = field(default_factory=TaskConfig)
     pipeline: PipelineConfig = field(default_factory=PipelineConfig)
-    # Table-top size (x, y) [m] used to check that objects stand on it.
-    table_size: list[float] = field(default_factory=lambda: [0.8, 1.2])
+    # The table: its top's size (x, y) [m] and where its top frame T sits in the world. The station
+    # builds the table from these (tg_drake.table); objects must stand within the top.
+    table_size: list[float] = field(default_factory=lambda: list(TABLE_SIZE))
     X_WT: Transform = field(default_factory=lambda: _transform(X_WT_DEFAULT))
 
     def target_placement(self) -> ObjectPlacement:
@@ -408,11 +407,10 @@ def _tidy_yaml_error(message: str) -> str:
 
 def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
     """Checks names and geometry that YAML typing alone cannot."""
-    if len(scenario.table_size) != 2 or not all(
-            _finite(v) and v > 0 for v in scenario.table_size):
-        raise ScenarioError(f"need two sizes > 0 [m], got {scenario.table_size}", file=where,
-                            field="table_size")
     names = set()
+    problem = table_size_problem(scenario.table_size)
+    if problem:
+        raise ScenarioError(problem, file=where, field="table_size")
     half = np.asarray(scenario.table_size) / 2
     for i, placement in enumerate(scenario.objects):
         f = f"objects[{i}]"

@@ -9,8 +9,11 @@ step than an explicit inverse-dynamics loop); the WSG's finger force is limited 
 actuators' effort limits, which SAP respects. Gravity on the arm and gripper is compensated (as the
 KUKA controller does for the arm and its configured payload); gravity acts on everything else.
 
-Cameras are `RgbdSensor`s rendered by `RenderEngineVtk`. A sensor renders only when one of its
-image ports is evaluated, so a stage that needs one image asks once, and the simulation itself never
+Cameras are `RgbdSensor`s added by Drake's `ApplyCameraConfig` from the scenario's `cameras`
+(the key names the camera; `renderer_name` and `renderer_class` choose its render engine:
+RenderEngineVtk, or RenderEngineGl where a display is available; anything else is a ScenarioError
+before the station is built). No images are published. A sensor renders only when one of its image
+ports is evaluated, so a stage that needs one image asks once, and the simulation itself never
 renders.
 
 Station ports (as exported by `make_station`; `add_station` returns the same ports by name):
@@ -23,10 +26,14 @@ Station ports (as exported by `make_station`; `add_station` returns the same por
 
 from __future__ import annotations
 
+import copy
+import functools
+import importlib.resources
 from dataclasses import dataclass, field
 
 import numpy as np
-from pydrake.geometry import MakeRenderEngineVtk, RenderEngineVtkParams, SceneGraph
+from pydrake.geometry import SceneGraph
+from pydrake.lcm import DrakeLcm
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import (AddModel, ModelDirective, ModelDirectives, Parser,
                                        ProcessModelDirectives)
@@ -35,15 +42,17 @@ from pydrake.multibody.tree import (JointActuatorIndex, ModelInstanceIndex, PdCo
                                     UnitInertia)
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import MatrixGain
-from pydrake.systems.sensors import CameraInfo, RgbdSensor
+from pydrake.systems.sensors import ApplyCameraConfig, CameraConfig, CameraInfo, RgbdSensor
 
-from tg_drake.errors import ModelError, ScenarioError
+from tg_drake.errors import ModelError, ScenarioError, unknown_name
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
 from tg_drake.robot_plants import add_scenario_models, make_parser
 from tg_drake.scenario import (InverseDynamicsDriver, JointPdDriver, ObjectPlacement, Scenario,
                                WsgPdDriver)
+from tg_drake.table import add_table
 
 WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container
+NO_LCM = "memq://null"  # the LCM URL that publishes nothing: the station sends no messages
 
 
 def placement_pose(scenario: Scenario, placement: ObjectPlacement) -> RigidTransform:
@@ -160,16 +169,24 @@ def _add_contents(plant: MultibodyPlant, instance, body, obj) -> None:
 
 def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
     """Adds the plant, scene graph, drivers and cameras of `scenario` to `builder`."""
+    _check_renderers(scenario)
     # Plant and scene graph, hydroelastic contact with SAP.
     plant, scene_graph = AddMultibodyPlant(scenario.plant_config, builder)
     parser = make_parser(plant)
 
-    # Robot, gripper, table from the directives; library objects from the `objects` block.
+    # Robot and gripper from the directives, the table from table_size and X_WT; library objects
+    # from the `objects` block.
     try:
         added = ProcessModelDirectives(ModelDirectives(directives=scenario.directives), parser)
     except RuntimeError as e:
         raise ModelError(f"could not load the scenario's directives: {e}") from None
     instances = {plant.GetModelInstanceName(i.model_instance): i.model_instance for i in added}
+    if plant.HasModelInstanceNamed("table"):
+        raise ScenarioError("the directives add a model named 'table'; the station adds the table "
+                            "itself, from table_size and X_WT: remove that directive",
+                            field="directives")
+    X_WT = scenario.X_WT.GetDeterministicValue()
+    instances["table"] = add_table(plant, scenario.table_size, X_WT)
     objects = _add_objects(scenario, plant, parser)
     instances.update(objects)
 
@@ -215,34 +232,82 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
     station.outputs["contact_results"] = plant.get_contact_results_output_port()
     station.outputs["query_object"] = scene_graph.get_query_output_port()
 
-    # Cameras: RgbdSensors rendered with VTK, which render only when asked.
-    if scenario.cameras:
-        scene_graph.AddRenderer("vtk", MakeRenderEngineVtk(RenderEngineVtkParams()))
+    # Cameras: Drake's ApplyCameraConfig adds each RgbdSensor (and its renderer, by the config's
+    # renderer_name and renderer_class); a sensor renders only when an image port is asked.
     for name, config in scenario.cameras.items():
-        color_camera, depth_camera = config.MakeCameras()
-        color_camera = _with_renderer(color_camera, "vtk")
-        depth_camera = _with_renderer_depth(depth_camera, "vtk")
-        X_PB = config.X_PB.GetDeterministicValue()
-        parent = scene_graph.world_frame_id()
-        if config.X_PB.base_frame and config.X_PB.base_frame != "world":
-            parent = plant.GetBodyFrameIdOrThrow(
-                plant.GetFrameByName(config.X_PB.base_frame).body().index())
-        sensor = builder.AddNamedSystem(
-            f"rgbd_sensor_{name}", RgbdSensor(parent_id=parent, X_PB=X_PB,
-                                              color_camera=color_camera,
-                                              depth_camera=depth_camera))
-        builder.Connect(scene_graph.get_query_output_port(), sensor.query_object_input_port())
-        X_BC = depth_camera.core().sensor_pose_in_camera_body()
-        pose = builder.AddNamedSystem(f"camera_pose_{name}", _CameraPose(X_BC))
-        builder.Connect(sensor.body_pose_in_world_output_port(), pose.get_input_port())
-        station.cameras[name] = CameraHandles(sensor=sensor,
-                                              info=depth_camera.core().intrinsics(),
-                                              X_PB=X_PB, X_BC=X_BC)
-        station.outputs[f"{name}.rgb_image"] = sensor.color_image_output_port()
-        station.outputs[f"{name}.depth_image"] = sensor.depth_image_32F_output_port()
-        station.outputs[f"{name}.label_image"] = sensor.label_image_output_port()
-        station.outputs[f"{name}.camera_pose"] = pose.get_output_port()
+        _add_camera(builder, station, name, config)
     return station
+
+
+# The renderer classes the station can build here (CameraConfig.renderer_class by name; the
+# parameter structs of the same engines are accepted too).
+RENDERER_CLASSES = ("RenderEngineVtk", "RenderEngineGl")
+
+
+@functools.cache
+def _gl_unavailable() -> str | None:
+    """Why RenderEngineGl cannot render on this machine (no display, no GL build), or None."""
+    from pydrake.geometry import MakeRenderEngineGl, RenderEngineGlParams, kHasRenderEngineGl
+    if not kHasRenderEngineGl:
+        return "this Drake build has no RenderEngineGl"
+    try:
+        MakeRenderEngineGl(RenderEngineGlParams())
+    except RuntimeError as e:
+        return " ".join(str(e).split())
+    return None
+
+
+def _renderer_class_name(renderer_class) -> str:
+    """The engine a CameraConfig.renderer_class asks for: a class name ("" = Drake's default,
+    RenderEngineVtk) or the class of its parameter struct."""
+    if isinstance(renderer_class, str):
+        return renderer_class or "RenderEngineVtk"
+    return type(renderer_class).__name__.removesuffix("Params")
+
+
+def _check_renderers(scenario: Scenario) -> None:
+    """Rejects, before anything is built, a camera whose renderer_class this machine cannot render
+    with, naming the field and the classes that work here."""
+    for name, config in scenario.cameras.items():
+        where = f"cameras.{name}.renderer_class"
+        usable = [c for c in RENDERER_CLASSES if c != "RenderEngineGl" or _gl_unavailable() is None]
+        engine = _renderer_class_name(config.renderer_class)
+        if engine == "RenderEngineGl" and _gl_unavailable() is not None:
+            raise ScenarioError(f"RenderEngineGl cannot render on this machine "
+                                f"({_gl_unavailable()}); allowed here: {', '.join(usable)}",
+                                field=where)
+        if engine == "RenderEngineGltfClient":
+            raise ScenarioError("RenderEngineGltfClient renders on a glTF server, which the "
+                                f"station does not run; allowed here: {', '.join(usable)}",
+                                field=where)
+        if engine not in RENDERER_CLASSES:
+            raise unknown_name("renderer class", engine, usable, error=ScenarioError,
+                               field=where)
+
+
+def _add_camera(builder: DiagramBuilder, station: Station, name: str, config: CameraConfig
+                ) -> None:
+    """One camera through ApplyCameraConfig (no image publishing: LCM is off), and its ports."""
+    if not (config.rgb or config.depth):
+        return  # ApplyCameraConfig adds no sensor for a camera with neither image
+    config = copy.deepcopy(config)
+    config.name = name  # the key in `cameras` names the camera (and its ports)
+    try:
+        ApplyCameraConfig(config=config, builder=builder, plant=station.plant,
+                          scene_graph=station.scene_graph, lcm=DrakeLcm(NO_LCM))
+    except RuntimeError as e:
+        raise ScenarioError(" ".join(str(e).split()), field=f"cameras.{name}") from None
+    sensor = builder.GetMutableSubsystemByName(f"rgbd_sensor_{name}")
+    depth_camera = sensor.default_depth_render_camera()
+    X_BC = depth_camera.core().sensor_pose_in_camera_body()
+    pose = builder.AddNamedSystem(f"camera_pose_{name}", _CameraPose(X_BC))
+    builder.Connect(sensor.body_pose_in_world_output_port(), pose.get_input_port())
+    station.cameras[name] = CameraHandles(sensor=sensor, info=depth_camera.core().intrinsics(),
+                                          X_PB=sensor.default_X_PB(), X_BC=X_BC)
+    station.outputs[f"{name}.rgb_image"] = sensor.color_image_output_port()
+    station.outputs[f"{name}.depth_image"] = sensor.depth_image_32F_output_port()
+    station.outputs[f"{name}.label_image"] = sensor.label_image_output_port()
+    station.outputs[f"{name}.camera_pose"] = pose.get_output_port()
 
 
 def _add_inverse_dynamics(builder, scenario, plant, iiwa, driver):
@@ -269,22 +334,6 @@ def _add_inverse_dynamics(builder, scenario, plant, iiwa, driver):
     builder.Connect(plant.get_state_output_port(iiwa), controller.get_input_port_estimated_state())
     builder.Connect(controller.get_output_port_control(), plant.get_actuation_input_port(iiwa))
     return controller
-
-
-def _with_renderer(color_camera, renderer_name: str):
-    from pydrake.geometry import ColorRenderCamera, RenderCameraCore
-    core = color_camera.core()
-    return ColorRenderCamera(
-        RenderCameraCore(renderer_name, core.intrinsics(), core.clipping(),
-                         core.sensor_pose_in_camera_body()), color_camera.show_window())
-
-
-def _with_renderer_depth(depth_camera, renderer_name: str):
-    from pydrake.geometry import DepthRenderCamera, RenderCameraCore
-    core = depth_camera.core()
-    return DepthRenderCamera(
-        RenderCameraCore(renderer_name, core.intrinsics(), core.clipping(),
-                         core.sensor_pose_in_camera_body()), depth_camera.depth_range())
 
 
 def make_station(scenario: Scenario) -> tuple[Diagram, Station]:

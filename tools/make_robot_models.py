@@ -22,6 +22,7 @@ from tg_drake.robot import (IIWA_FLANGE_Z, IIWA_JOINTS, WSG_BODY, WSG_BODY_CENTR
                             WSG_BODY_SIZE, WSG_FINGER_JOINTS, WSG_FINGER_MASS, WSG_FINGER_VELOCITY,
                             WSG_FINGERS, WSG_FORCE_LIMIT, WSG_PAD_CENTRE_Y, WSG_PAD_SIZE,
                             WSG_STROKE)
+from tg_drake.table import table_sdf
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 
@@ -52,10 +53,7 @@ IIWA_ORANGE = "1.0 0.42 0.04 1"
 
 PAD_HYDRO = dict(modulus=1e6, resolution=0.005, dissipation=3.0, mu=1.0)
 
-# Table: a top slab on four legs, its top compliant.
-TABLE_TOP_SIZE = (0.8, 1.2, 0.04)  # x (depth, away from the robot) × y (width) × z [m]
-TABLE_HEIGHT = 0.4  # [m] table-top surface above the floor.
-TABLE_HYDRO = dict(modulus=1e7, resolution=0.1, dissipation=3.0, mu=0.5)
+# The table's facts and model are tg_drake.table's (the station sizes it from the scenario).
 
 
 def _f(v) -> str:
@@ -203,36 +201,6 @@ def wsg_sdf() -> str:
         "      </collision>\n    </link>\n"
         + "".join(fingers)
         + "  </model>\n</sdf>\n")
-
-
-def table_sdf() -> str:
-    tx, ty, tz = TABLE_TOP_SIZE
-    legs = []
-    for i, (sx, sy) in enumerate(((1, 1), (1, -1), (-1, 1), (-1, -1))):
-        pose = f"{sx * (tx / 2 - 0.05):.6g} {sy * (ty / 2 - 0.05):.6g} {-(TABLE_HEIGHT + tz) / 2:.6g} 0 0 0"
-        legs.append(f'      <visual name="leg_{i}">\n        <pose>{pose}</pose>\n'
-                    f"        <geometry><box><size>0.05 0.05 {TABLE_HEIGHT - tz}</size></box></geometry>\n"
-                    "        <material><diffuse>0.45 0.3 0.2 1</diffuse></material>\n      </visual>\n")
-    top_pose = f"0 0 {-tz / 2} 0 0 0"
-    return (
-        '<?xml version="1.0"?>\n'
-        "<!-- Table, written by tools/make_robot_models.py. Frame `table_top`: origin at the centre of\n"
-        "     the top surface, z up. The top is a compliant-hydroelastic box (robot_facts.md);\n"
-        "     the legs are visual only. Weld `table_top` to the world. Do not edit by hand. -->\n"
-        '<sdf version="1.9" xmlns:drake="http://drake.mit.edu">\n'
-        '  <model name="table">\n'
-        '    <link name="table_top">\n'
-        + _sdf_inertial(20.0, TABLE_TOP_SIZE, top_pose)
-        + '      <visual name="top_visual">\n'
-        f"        <pose>{top_pose}</pose>\n"
-        f"        <geometry><box><size>{tx} {ty} {tz}</size></box></geometry>\n"
-        "        <material><diffuse>0.82 0.78 0.7 1</diffuse></material>\n      </visual>\n"
-        + "".join(legs)
-        + '      <collision name="top_collision">\n'
-        f"        <pose>{top_pose}</pose>\n"
-        f"        <geometry><box><size>{tx} {ty} {tz}</size></box></geometry>\n"
-        + _compliant(TABLE_HYDRO)
-        + "      </collision>\n    </link>\n  </model>\n</sdf>\n")
 
 
 FILES = {

@@ -90,9 +90,10 @@ def grid_search(X, y, cv, groups=None) -> GridSearchCV:
                         n_jobs=1).fit(X, y, groups=groups)
 
 
-def nested_objectwise_probabilities(X, y, objects) -> tuple[np.ndarray, list[dict]]:
+def nested_objectwise_probabilities(X, y, objects, *, cv_seed: int = 0
+                                    ) -> tuple[np.ndarray, list[dict]]:
     """Held-out P of 4 folds grouped by object; each fold's γ and C chosen by a 3-fold search
-    grouped by object on its training objects only."""
+    grouped by object on its training objects only (`cv_seed` shuffles the sigmoid's folds)."""
     p = np.empty(len(y))
     chosen = []
     for train, test in GroupKFold(4).split(X, y, groups=objects):
@@ -101,7 +102,7 @@ def nested_objectwise_probabilities(X, y, objects) -> tuple[np.ndarray, list[dic
         chosen.append({"gamma": float(params["gamma"]), "C": float(params["C"]),
                        "inner_accuracy": float(search.best_score_)})
         estimator = PlattSvmClassifier(gamma=params["gamma"], C=params["C"], n_folds=4,
-                                       random_state=0)
+                                       random_state=cv_seed)
         p[test] = estimator.fit(X[train], y[train]).predict_proba(X[test])[:, 1]
     return p, chosen
 
@@ -183,6 +184,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--data", type=Path, default=Path("data/dgi/grasps_light.jsonl"))
     parser.add_argument("--seed", type=int, default=0, help="the collection's seed")
+    parser.add_argument("--cv-seed", type=int, default=0,
+                        help="shuffles the stratified cross-validation folds (and the Platt "
+                             "sigmoid's folds)")
     parser.add_argument("--model-out", type=Path,
                         default=Path(str(files("tg_drake"))) / "data" / "dgi_svm.joblib")
     parser.add_argument("--results", type=Path, default=Path("docs/results"))
@@ -216,17 +220,18 @@ def main(argv=None) -> int:
           f"{X.shape[1]} features", flush=True)
 
     # 1. γ and C by 4-fold stratified cross-validation (SVM decision, as the paper's search).
-    stratified = StratifiedKFold(4, shuffle=True, random_state=0)
+    stratified = StratifiedKFold(4, shuffle=True, random_state=args.cv_seed)
     search = grid_search(X, y, stratified)
     gamma, C = search.best_params_["gamma"], search.best_params_["C"]
     print(f"gamma {gamma}, C {C}: {search.best_score_:.4f}", flush=True)
-    estimator = PlattSvmClassifier(gamma=gamma, C=C, n_folds=4, random_state=0)
+    estimator = PlattSvmClassifier(gamma=gamma, C=C, n_folds=4, random_state=args.cv_seed)
 
     # 2. cross-validated accuracy of SVM + sigmoid, and 3. top grasp per scene on unseen objects.
     p_cv = held_out_probabilities(estimator, X, y, stratified.split(X, y))
     cv_accuracy = float(np.mean((p_cv >= 0.5) == y))
     objectwise = list(GroupKFold(4).split(X, y, groups=data.object_ids))
-    p_obj, nested_params = nested_objectwise_probabilities(X, y, data.object_ids)
+    p_obj, nested_params = nested_objectwise_probabilities(X, y, data.object_ids,
+                                                           cv_seed=args.cv_seed)
     top = top_grasp_accuracy(p_obj, y, data.scenes)
     top_seen = top_grasp_accuracy(p_cv, y, data.scenes)
     box = data.kinds == "box"

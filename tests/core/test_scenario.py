@@ -18,7 +18,9 @@ def test_missing_keys_keep_defaults(tmp_path):
     assert scenario.plant_config.contact_model == "hydroelastic_with_fallback"
     assert scenario.plant_config.discrete_contact_approximation == "sap"
     assert isinstance(scenario.model_drivers["iiwa"], JointPdDriver)
-    assert [d.add_model.name for d in scenario.directives if d.add_model] == ["iiwa", "wsg", "table"]
+    # The table is not a directive: the station builds it from table_size and X_WT.
+    assert [d.add_model.name for d in scenario.directives if d.add_model] == ["iiwa", "wsg"]
+    assert scenario.table_size == [0.8, 1.2]
 
 
 def test_tagged_driver_union_is_chosen_in_yaml(tmp_path):
@@ -200,7 +202,7 @@ def test_a_missing_named_entry_lists_the_entries(tmp_path):
     ("simulator_config: {max_step_size: 0}\n", "simulator_config.max_step_size", "> 0 [s]"),
     ("task: {place_xy: [0.0, -0.9]}\n", "task.place_xy", "is off the table"),
     ("task: {place_xy: [.nan, 0]}\n", "task.place_xy", "two finite numbers"),
-    ("table_size: [0.8, -1]\n", "table_size", "two sizes > 0"),
+    ("table_size: [0.8, -1]\n", "table_size", "each side at least"),
 ])
 def test_simulation_settings_are_checked_before_building(tmp_path, text, field, message):
     with pytest.raises(ScenarioError) as e:

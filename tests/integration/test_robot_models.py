@@ -139,22 +139,21 @@ def test_wsg_pads_and_body(station_robot, opening):
 def test_robot_plants_hold_only_the_named_models():
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    added = add_scenario_models(plant, None, ("iiwa", "wsg", "table"))
-    assert sorted(plant.GetModelInstanceName(i.model_instance) for i in added) \
-        == ["iiwa", "table", "wsg"]
+    added = add_scenario_models(plant, None, ("iiwa", "wsg"))
+    assert sorted(plant.GetModelInstanceName(i.model_instance) for i in added) == ["iiwa", "wsg"]
     # A weld whose child belongs to a model left out is left out too.
     kept = model_directives(None, ("iiwa", "wsg"))
     assert {d.add_model.name for d in kept if d.add_model} == {"iiwa", "wsg"}
     assert [d.add_weld.child for d in kept if d.add_weld] == ["iiwa::iiwa_link_0", "wsg::body"]
-    assert len(default_directives()) == 6
+    assert len(default_directives()) == 4  # the table is added from table_size, not a directive
 
 
 def test_a_robot_plant_names_a_model_the_scenario_lacks():
     scenario = Scenario(directives=[d for d in default_directives()
-                                    if not (d.add_model and d.add_model.name == "table")
-                                    and not (d.add_weld and d.add_weld.child.startswith("table"))])
-    with pytest.raises(ScenarioError, match="no model named table"):
-        model_directives(scenario, ("iiwa", "wsg", "table"))
+                                    if not (d.add_model and d.add_model.name == "wsg")
+                                    and not (d.add_weld and d.add_weld.child.startswith("wsg"))])
+    with pytest.raises(ScenarioError, match="no model named wsg"):
+        model_directives(scenario, ("iiwa", "wsg"))
 
 
 def test_the_inverse_dynamics_controller_models_the_arm_with_the_gripper_as_payload():

@@ -63,11 +63,13 @@ def open_top(p_O: np.ndarray, labels: np.ndarray) -> bool:
 
 
 @functools.lru_cache(maxsize=None)
-def library_open_top(obj_id: str) -> bool:
-    """`open_top` of a library object, on a fixed sampling of 4,000 surface points."""
+def library_open_top(obj_id: str, seed: int = 0) -> bool:
+    """`open_top` of a library object, on a sampling of 4,000 surface points drawn with `seed`
+    (a property of the object, not of a run: the default sampling is the one the labels use)."""
     from tg_drake.objects import get_object, sample_surface
 
-    p_O, _, labels = sample_surface(get_object(obj_id), n=4000, rng=np.random.default_rng(0))
+    p_O, _, labels = sample_surface(get_object(obj_id), n=4000,
+                                    rng=np.random.default_rng(seed))
     return open_top(p_O, labels)
 
 

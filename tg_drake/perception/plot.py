@@ -22,15 +22,17 @@ from tg_drake.types import PART_COLORS, PART_LABELS, ObjectDescription  # noqa: 
 MAX_POINTS = 6000
 
 
-def _subset(n: int) -> np.ndarray:
+def _subset(n: int, seed: int) -> np.ndarray:
     if n <= MAX_POINTS:
         return np.arange(n)
-    return np.sort(np.random.default_rng(0).choice(n, MAX_POINTS, replace=False))
+    return np.sort(np.random.default_rng(seed).choice(n, MAX_POINTS, replace=False))
 
 
-def draw_object(ax, o: ObjectDescription, *, elev: float = 25.0, azim: float = -60.0) -> None:
-    """Draws one object's part-coloured completed cloud on a 3D axis, in the object frame O."""
-    idx = _subset(len(o.p_W))
+def draw_object(ax, o: ObjectDescription, *, elev: float = 25.0, azim: float = -60.0,
+                seed: int = 0) -> None:
+    """Draws one object's part-coloured completed cloud on a 3D axis, in the object frame O
+    (`seed` picks the subset drawn of a cloud larger than MAX_POINTS)."""
+    idx = _subset(len(o.p_W), seed)
     p_O = (o.p_W[idx] - o.X_WO[:3, 3]) @ o.X_WO[:3, :3]
     colours = np.asarray(PART_COLORS)[o.labels[idx]]
     alpha = np.where(o.visible[idx], 1.0, 0.25)
@@ -49,14 +51,16 @@ def draw_object(ax, o: ObjectDescription, *, elev: float = 25.0, azim: float = -
                  fontsize=8)
 
 
-def save_object_png(o: ObjectDescription, path: str | Path, *, dpi: int = 120) -> Path:
+def save_object_png(o: ObjectDescription, path: str | Path, *, dpi: int = 120,
+                    seed: int = 0) -> Path:
     """Writes a PNG of one object's completed, part-coloured cloud (two views) and returns its
-    path."""
+    path (`seed`: see `draw_object`)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig = plt.figure(figsize=(8, 4))
     for i, (elev, azim) in enumerate(((25.0, -60.0), (25.0, 120.0))):
-        draw_object(fig.add_subplot(1, 2, i + 1, projection="3d"), o, elev=elev, azim=azim)
+        draw_object(fig.add_subplot(1, 2, i + 1, projection="3d"), o, elev=elev, azim=azim,
+                    seed=seed)
     present = sorted(set(np.unique(o.labels)))
     fig.legend(handles=[Patch(color=PART_COLORS[i], label=PART_LABELS[i]) for i in present],
                loc="lower center", ncol=len(present), fontsize=8)
@@ -66,15 +70,16 @@ def save_object_png(o: ObjectDescription, path: str | Path, *, dpi: int = 120) -
     return path
 
 
-def save_scene_png(objects: list[ObjectDescription], path: str | Path, *, dpi: int = 120
-                   ) -> Path:
-    """Writes a PNG with one panel per object of a scene description and returns its path."""
+def save_scene_png(objects: list[ObjectDescription], path: str | Path, *, dpi: int = 120,
+                   seed: int = 0) -> Path:
+    """Writes a PNG with one panel per object of a scene description and returns its path
+    (`seed`: see `draw_object`)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     n = max(1, len(objects))
     fig = plt.figure(figsize=(4 * n, 4))
     for i, o in enumerate(objects):
-        draw_object(fig.add_subplot(1, n, i + 1, projection="3d"), o)
+        draw_object(fig.add_subplot(1, n, i + 1, projection="3d"), o, seed=seed)
     fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     plt.close(fig)

@@ -24,13 +24,14 @@ from pydrake.systems.framework import DiagramBuilder
 
 from tg_drake.robot import (IIWA_HOME, IIWA_JOINT_NAMES, WSG_BODY, WSG_FINGER_JOINTS, WSG_FINGERS,
                             WSG_MAX_OPENING)
+from tg_drake.table import add_table
 
 if TYPE_CHECKING:
     from tg_drake.scenario import Scenario
 
-# The scenario's models in the planning plant: the robot, the gripper and the table; loose objects
-# become obstacles if at all.
-PLANNING_MODELS = ("iiwa", "wsg", "table")
+# The scenario's models in the planning plant: the robot and the gripper (the table is added from
+# the scenario's table_size); loose objects become obstacles if at all.
+PLANNING_MODELS = ("iiwa", "wsg")
 
 
 # Weight of the IK's pull towards its seed [1/rad²]: a preference among the solutions that meet
@@ -75,10 +76,13 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
     # The scenario schema composes the planner's config, which imports this module: the builder
     # of the scenario's models (which reads the schema) is imported when a plant is made.
     from tg_drake.robot_plants import add_scenario_models
+    from tg_drake.scenario import Scenario
 
+    scenario = scenario or Scenario()
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     add_scenario_models(plant, scenario, PLANNING_MODELS)
+    add_table(plant, scenario.table_size, scenario.X_WT.GetDeterministicValue())
     # Fix the fingers at the given opening: weld-like by locking their joints in IK (bounds).
     world = plant.world_body()
     added = []
