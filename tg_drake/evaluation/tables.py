@@ -20,6 +20,7 @@ from collections import defaultdict
 
 import numpy as np
 
+from tg_drake.evaluation.paper import PAPER
 from tg_drake.evaluation.suite import DATASETS
 from tg_drake.types import CATEGORIES, PART_LABELS, TASKS
 
@@ -35,73 +36,6 @@ LABELS = {"random": "Random", "label_fractions": "Label fractions", "manifolds":
           "plm_nonexclusive": "PLM, not mutually exclusive",
           "plm_paper_observations": "PLM, the paper's observations only", "local": "Local",
           "pipeline": "Pipeline", "pipeline_uniform": "Pipeline_uniform"}
-
-# The paper's figures [%], section VI (table labels in the paper's LaTeX).
-PAPER = {
-    # tab:visualRepresentation
-    "detection": {"grasp": {"part_accuracy": 84.56, "pose_accuracy": 100.0},
-                  "robot": {"part_accuracy": 82.14, "pose_accuracy": 100.0}},
-    # tab:object_category_graphkernel (and the text for "ties ok")
-    "category": {
-        "syn": {"random": 9.1, "label_fractions": 63.4, "manifolds": 87.8, "plm_uniform": 31.37,
-                "plm_general_uniform": 31.37, "plm": 93.14, "plm_general": 92.16},
-        "real_semi": {"random": 9.1, "label_fractions": 39.7, "manifolds": 39.7,
-                      "plm_uniform": 14.29, "plm_general_uniform": 14.29, "plm": 49.21,
-                      "plm_general": 46.83},
-        "real": {"random": 9.1, "label_fractions": 39.7, "manifolds": 39.7, "plm_uniform": 14.29,
-                 "plm_general_uniform": 14.29, "plm": 48.41, "plm_general": 46.83},
-        "real_noisy": {"random": 9.1, "label_fractions": 39.7, "manifolds": 39.7,
-                       "plm_uniform": 14.29, "plm_general_uniform": 14.29, "plm": 39.7,
-                       "plm_general": 39.7},
-        "grasp": {"random": 9.1, "manifolds": 37.95},
-        "robot": {"random": 9.1, "manifolds": 50.0},
-    },
-    "category_ties_ok": {"syn": {"plm_uniform": 99.02, "plm_general_uniform": 94.12},
-                         "real": {"plm_uniform": 68.25, "plm_general_uniform": 62.70}},
-    # tab:task_plm_e0 (E_0; S_GRASP and S_ROBOT also E_1)
-    "task": {
-        "syn": {"plm_uniform": 71.57, "plm_general_uniform": 65.69, "plm": 72.55,
-                "plm_general": 72.55},
-        "real_semi": {"plm_uniform": 98.41, "plm_general_uniform": 98.41, "plm": 95.24,
-                      "plm_general": 93.65},
-        "real": {"plm_uniform": 80.16, "plm_general_uniform": 80.16, "plm": 95.24,
-                 "plm_general": 93.65},
-        "real_noisy": {"plm_uniform": 38.10, "plm_general_uniform": 38.10, "plm": 93.65,
-                       "plm_general": 93.65},
-    },
-    # tab:pregrasp_taskgiven_e0 (task given, E_0)
-    "pregrasp": {
-        "syn": {"plm_uniform": 81.23, "plm_general_uniform": 80.67, "plm": 85.29,
-                "plm_general": 84.73},
-        "real_semi": {"plm_uniform": 69.95, "plm_general_uniform": 72.00, "plm": 85.26,
-                      "plm_general": 86.73},
-        "real": {"plm_uniform": 72.00, "plm_general_uniform": 72.00, "plm": 85.26,
-                 "plm_general": 84.69},
-        "real_noisy": {"plm_uniform": 69.16, "plm_general_uniform": 69.16, "plm": 85.49,
-                       "plm_general": 86.73},
-        "grasp": {"pipeline_uniform": 66.7, "pipeline": 75.51},
-        "robot": {"pipeline_uniform": 66.7, "pipeline": 66.7},
-    },
-    # tab:pipeline: share of successful grasps with P(grasp | local shape) below a threshold
-    "pipeline_vs_local": {
-        "grasp": {"local": {"0.5": 44.55, "0.4": 27.27, "0.3": 4.55},
-                  "pipeline": {"0.5": 52.38, "0.4": 28.57, "0.3": 7.94},
-                  "pipeline_uniform": {"0.5": 50.0, "0.4": 21.15, "0.3": 7.69}},
-        "robot": {"local": {"0.5": 37.5, "0.4": 25.0, "0.3": 12.5},
-                  "pipeline": {"0.5": 50.0, "0.4": 42.86, "0.3": 28.57},
-                  "pipeline_uniform": {"0.5": 46.15, "0.4": 23.08, "0.3": 23.08}},
-    },
-    # tab:realRobotGlobalStats: scenario1-3 = 2, 3, 4 objects
-    "grasp_and_place": {"2": {"total": 10, "reachable": 90.0, "grasped": 77.8, "placed": 77.8},
-                        "3": {"total": 15, "reachable": 66.7, "grasped": 70.0, "placed": 70.0},
-                        "4": {"total": 20, "reachable": 80.0, "grasped": 50.0, "placed": 50.0}},
-    # section VI-C text: only the top category fed to the PLM (S_REAL_semi, S_REAL, noisy)
-    "top_category": {"task": {"real_semi": 95.24, "real": 89.68, "real_noisy": 89.68},
-                     "pregrasp": {"real_semi": 81.63, "real": 81.63, "real_noisy": 82.88}},
-    # section VI-C text: mean (exclusive − non-exclusive) over the datasets
-    "exclusive_minus_nonexclusive": {"category": 1.6, "task": 8.5, "pregrasp": 2.6},
-}
-
 
 def top_set(p: np.ndarray) -> set[int]:
     """Indices tied at the maximum (empty when everything is 0)."""
@@ -411,8 +345,10 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
     L += ["", "Second definition (ties count as success) for the uniform prior: " + "; ".join(
         f"{name(d)}: PLM_uniform **{_f(r.get('plm_uniform_ties_ok'))}**, PLM^general_uniform "
         f"**{_f(r.get('plm_general_uniform_ties_ok'))}**" for d, r in t["category"].items()
-        if "plm_uniform_ties_ok" in r) + " (paper: S_SYN 99.02 and 94.12; S_REAL 68.25 and "
-        "62.70). In executed suites PLM is the pipeline's logic and PLM_uniform the "
+        if "plm_uniform_ties_ok" in r) + " (paper: " + "; ".join(
+        f"{DATASETS[d]}{' datasets' if d == 'real' else ''} {_f(v['plm_uniform'])} and "
+        f"{_f(v['plm_general_uniform'])}" for d, v in P["category_ties_ok"].items())
+        + "). In executed suites PLM is the pipeline's logic and PLM_uniform the "
         "pipeline_uniform variant's; Manifolds is the pipeline's kernel prior."]
 
     L += ["", "## Task (paper Table \"task_plm_e0\" and Fig. \"task_plm\"; task inferred)", ""]
@@ -473,9 +409,9 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
           "| objects | runs | reachable pre-grasps | grasped | placed | not placed, by reason |",
           "|---|---|---|---|---|---|"]
     for n, r in t["grasp_and_place"].items():
-        p = P["grasp_and_place"].get(n, {})
+        p = P["grasp_and_place_pct"].get(n, {})
         L.append(f"| {n} ({', '.join(name(d) for d in r['datasets'])}) | {r['total']} "
-                 f"({_f(p.get('total'))}) | {r['reachable']} "
+                 f"({_f(P['grasp_and_place'].get(n, {}).get('total'))}) | {r['reachable']} "
                  f"{_both(r['reachable_pct'], p.get('reachable'))} | {r['grasped']} "
                  f"{_both(r['grasped_pct'], p.get('grasped'))} | {r['placed']} "
                  f"{_both(r['placed_pct'], p.get('placed'))} | "
@@ -487,10 +423,10 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
           "top only |", "|---|---|---|---|---|---|---|"]
     for d, r in a["top_category"].items():
         f, o = r["full_prior"], r["top_category"]
-        pt = P["top_category"]
         L.append(f"| {name(d)} | {_f(f['category'])} | {_f(o['category'])} | {_f(f['task_E0'])} | "
-                 f"{_both(o['task_E0'], pt['task'].get(d))} | {_f(f['pregrasp_E0'])} | "
-                 f"{_both(o['pregrasp_E0'], pt['pregrasp'].get(d))} |")
+                 f"{_both(o['task_E0'], P['top_category_task'].get(d))} | "
+                 f"{_f(f['pregrasp_E0'])} | "
+                 f"{_both(o['pregrasp_E0'], P['top_category_pregrasp'].get(d))} |")
     L += ["", "## Ablation: mutually exclusive versus not (PLM)", "",
           "| dataset | category excl. | not | task E0 excl. | not | pre-grasp E0 excl. | not |",
           "|---|---|---|---|---|---|---|"]
