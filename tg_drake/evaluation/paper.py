@@ -37,7 +37,8 @@ def _table(measure: str, source: str, cells: dict, unit: str = "%", _key=()) -> 
             _table(measure, source, cell, unit, key)
         else:
             where = ", ".join(f"{what} {k}" for what, k in zip(("row", "column", "entry"), key))
-            FIGURES.append(Figure((measure, *key), float(cell), unit, f"{source}: {measure}, {where}"))
+            FIGURES.append(Figure((measure, *key), float(cell), unit,
+                                  f"{source}: {measure}, {where}"))
 
 
 # -- Section VI-A: the datasets ---------------------------------------------------------------

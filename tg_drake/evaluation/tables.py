@@ -114,6 +114,54 @@ def detection(records) -> dict:
     return out
 
 
+def _per_object(logic) -> list[dict]:
+    """Synthetic records: the first of each object (its prior is the object's); other kinds: all
+    (a perceived prior is one per view)."""
+    seen: dict = {}
+    for r in logic:
+        seen.setdefault(r["object"] if r.get("kind") == "synthetic" else r["job"] + str(
+            r.get("setting")), r)
+    return list(seen.values())
+
+
+def per_category(records) -> dict:
+    """Category accuracy (argmax, ties fail) per true category, for each logic dataset: the
+    kernel prior (Manifolds, per object as in `category`) and the logic methods."""
+    out = {}
+    for dataset, rs in _by_dataset(records).items():
+        logic = _logic(rs)
+        if not logic:
+            continue
+        table: dict = {}
+        for c in CATEGORIES:
+            mine = [r for r in logic if r["truth"]["category"] == c]
+            if not mine:
+                continue
+            i = CATEGORIES.index(c)
+            table[c] = {"n": len(mine), "manifolds": _pct([
+                r.get("priors") is not None and _argmax_ok(r["priors"]["manifolds"], i)
+                for r in _per_object(mine)])}
+            for m in LOGIC_METHODS:
+                table[c][m] = _pct([_method(r, m) is not None and
+                                    _argmax_ok(_method(r, m)["category"], i) for r in mine])
+        out[dataset] = table
+    return out
+
+
+def impossible_evidence(records) -> dict:
+    """Per logic dataset and method: the cases whose observations have probability 0 under the
+    method's theory (a kernel prior certain of a category the observed parts rule out); they
+    count as failures of every measure."""
+    out = {}
+    for dataset, rs in _by_dataset(records).items():
+        counts = {m: sum(1 for r in _logic(rs)
+                             if "error" in ((r.get("methods") or {}).get(m) or {}))
+                  for m in (*LOGIC_METHODS, *ABLATION_METHODS)}
+        if _logic(rs):
+            out[dataset] = {m: n for m, n in counts.items() if n}
+    return out
+
+
 def category(records) -> dict:
     out = {}
     for dataset, rs in _by_dataset(records).items():
@@ -121,9 +169,14 @@ def category(records) -> dict:
         logic = _logic(rs)
         if logic:
             truth = [CATEGORIES.index(r["truth"]["category"]) for r in logic]
+            # A synthetic prior is one per object (one labelled sampling of its mesh), so its
+            # accuracy is over the objects, as the paper's S_SYN Manifolds (36 of 41 objects).
+            objects = _per_object(logic)
+            table["n_objects"] = len(objects)
             for prior in ("label_fractions", "manifolds"):
-                table[prior] = _pct([r.get("priors") is not None and
-                                     _argmax_ok(r["priors"][prior], t) for r, t in zip(logic, truth)])
+                table[prior] = _pct([r.get("priors") is not None and _argmax_ok(
+                    r["priors"][prior], CATEGORIES.index(r["truth"]["category"]))
+                    for r in objects])
             for m in (*LOGIC_METHODS, *ABLATION_METHODS):
                 table[m] = _pct([_method(r, m) is not None and
                                  _argmax_ok(_method(r, m)["category"], t)
@@ -162,7 +215,8 @@ def task(records) -> dict:
         if not logic:
             continue
         n_i = _max_i(logic, "task") + 1
-        table = {"n": len(logic)}
+        sizes = [len(r["truth"]["tasks"]) for r in logic]
+        table = {"n": len(logic), "gt_sizes": {str(k): sizes.count(k) for k in sorted(set(sizes))}}
         for m in (*LOGIC_METHODS, *ABLATION_METHODS):
             table[m] = {}
             for i in range(n_i):
@@ -294,6 +348,8 @@ def compute(records: list[dict]) -> dict:
             "n_errors": sum("error" in r for r in records),
             "records_per_dataset": {d: dict(v) for d, v in counts.items()},
             "detection": detection(records), "category": cat, "task": tsk, "pregrasp": pre,
+            "per_category": per_category(records),
+            "impossible_evidence": impossible_evidence(records),
             "pipeline_vs_local": pipeline_vs_local(records),
             "grasp_and_place": grasp_and_place(records),
             "ablations": ablations(cat, tsk, pre), "paper": PAPER}
@@ -326,9 +382,11 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
     L += [f"Records: {t['n_records']} ({t['n_errors']} crashed cases, counted as failures): "
           + ", ".join(f"{name(d)} {dict(v)}" for d, v in t["records_per_dataset"].items()), ""]
 
-    L += ["## Pose and part detection (paper Table \"visualRepresentation\")", "",
-          "| dataset | views | pose | parts | upright + sideways: pose | parts |",
-          "|---|---|---|---|---|---|"]
+    # A section whose table would be empty (no suite of its kind given) is left out.
+    if t["detection"]:
+        L += ["## Pose and part detection (paper Table \"visualRepresentation\")", "",
+              "| dataset | views | pose | parts | upright + sideways: pose | parts |",
+              "|---|---|---|---|---|---|"]
     for d, r in t["detection"].items():
         p = P["detection"].get(d, {})
         L.append(f"| {name(d)} | {r['n']} | {_f(r['pose_accuracy'])} | {_f(r['part_accuracy'])} "
@@ -349,12 +407,30 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
         f"{DATASETS[d]}{' datasets' if d == 'real' else ''} {_f(v['plm_uniform'])} and "
         f"{_f(v['plm_general_uniform'])}" for d, v in P["category_ties_ok"].items())
         + "). In executed suites PLM is the pipeline's logic and PLM_uniform the "
-        "pipeline_uniform variant's; Manifolds is the pipeline's kernel prior."]
+        "pipeline_uniform variant's; Manifolds is the pipeline's kernel prior. "
+        + " ".join(f"{name(d)}: Label fractions and Manifolds over its {r['n_objects']} objects "
+                   f"(one prior per object, as the paper's 36 of 41), the PLM columns over its "
+                   f"{r['n']} cases." for d, r in t["category"].items()
+                   if r.get("n_objects") and r["n_objects"] != r.get("n"))]
+    impossible = {d: v for d, v in t.get("impossible_evidence", {}).items() if v}
+    L += ["", "Cases whose observations are impossible under a method's theory (a kernel prior "
+          "certain of a category the observed parts rule out), counted as failures: "
+          + ("; ".join(f"{name(d)}: " + ", ".join(f"{LABELS[m]} {n}" for m, n in v.items())
+                       for d, v in impossible.items()) or "none") + "."]
+    for d, r in t.get("per_category", {}).items():
+        ms = ("manifolds", *LOGIC_METHODS)
+        L += ["", f"{name(d)}, category accuracy per true category:", "",
+              "| category | cases | " + " | ".join(LABELS[m] for m in ms) + " |",
+              "|---|---|" + "---|" * len(ms)]
+        for c, row in r.items():
+            L.append(f"| {c} | {row['n']} | " + " | ".join(_f(row[m]) for m in ms) + " |")
 
-    L += ["", "## Task (paper Table \"task_plm_e0\" and Fig. \"task_plm\"; task inferred)", ""]
+    if t["task"]:
+        L += ["", "## Task (paper Table \"task_plm_e0\" and Fig. \"task_plm\"; task inferred)", ""]
     for d, r in t["task"].items():
         ks = list(r["plm"])
-        L += [f"{name(d)} ({r['n']} scenarios):", "",
+        L += [f"{name(d)} ({r['n']} scenarios; ground-truth task sets of size "
+              + ", ".join(f"{k}: {v}" for k, v in r.get("gt_sizes", {}).items()) + "):", "",
               "| method | " + " | ".join(ks) + " |", "|---|" + "---|" * len(ks)]
         for m in LOGIC_METHODS:
             L.append(f"| {LABELS[m]} | " + " | ".join(
@@ -362,8 +438,9 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
                 for k in ks) + " |")
         L.append("")
 
-    L += ["## Pre-grasp (paper Table \"pregrasp_taskgiven_e0\" and Fig. "
-          "\"pregrasp_taskgiven_plm\"; task given)", ""]
+    if t["pregrasp"]:
+        L += ["## Pre-grasp (paper Table \"pregrasp_taskgiven_e0\" and Fig. "
+              "\"pregrasp_taskgiven_plm\"; task given)", ""]
     for d, r in t["pregrasp"].items():
         if "plm" in r:
             ks = list(r["plm"])
@@ -387,10 +464,12 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
                          f"{_f(x['E0_logic'])} |")
             L.append("")
 
-    L += ["## Pipeline versus local shape only (paper Table \"pipeline\")", "",
-          "Share of successful grasps (object held through the lift) whose P(grasp | local shape) "
-          "is below the threshold, on the scenarios every variant ran. Local ranks all hypotheses "
-          "by P(grasp | local shape) alone (`PipelineConfig.grasp_selection: local_only`).", ""]
+    if t["pipeline_vs_local"]:
+        L += ["## Pipeline versus local shape only (paper Table \"pipeline\")", "",
+              "Share of successful grasps (object held through the lift) whose P(grasp | local "
+              "shape) is below the threshold, on the scenarios every variant ran. Local ranks all "
+              "hypotheses by P(grasp | local shape) alone (`PipelineConfig.grasp_selection: "
+              "local_only`).", ""]
     for d, r in t["pipeline_vs_local"].items():
         vs = [v for v in ("local", "pipeline", "pipeline_uniform") if v in r]
         p = P["pipeline_vs_local"].get(d, {})
@@ -403,11 +482,12 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
                                                   for v in vs) + " |")
         L.append("")
 
-    L += ["## Grasp and place per scene complexity (paper Table \"realRobotGlobalStats\")", "",
-          "Pipeline variant; grasped and placed over the runs with a reachable pre-grasp, as the "
-          "paper.", "",
-          "| objects | runs | reachable pre-grasps | grasped | placed | not placed, by reason |",
-          "|---|---|---|---|---|---|"]
+    if t["grasp_and_place"]:
+        L += ["## Grasp and place per scene complexity (paper Table \"realRobotGlobalStats\")",
+              "", "Pipeline variant; grasped and placed over the runs with a reachable pre-grasp, "
+              "as the paper.", "",
+              "| objects | runs | reachable pre-grasps | grasped | placed | not placed, by "
+              "reason |", "|---|---|---|---|---|---|"]
     for n, r in t["grasp_and_place"].items():
         p = P["grasp_and_place_pct"].get(n, {})
         L.append(f"| {n} ({', '.join(name(d) for d in r['datasets'])}) | {r['total']} "
@@ -418,6 +498,8 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
                  + ", ".join(f"{k} {v}" for k, v in r["failures"].items()) + " |")
 
     a = t["ablations"]
+    if not a["top_category"]:
+        return "\n".join(L) + "\n"
     L += ["", "## Ablation: the top category only versus the full prior (PLM)", "",
           "| dataset | category full | top only | task E0 full | top only | pre-grasp E0 full | "
           "top only |", "|---|---|---|---|---|---|---|"]
@@ -439,8 +521,9 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
           f"{_both(md['category'], pm['category'])}, task {_both(md['task_E0'], pm['task'])}, "
           f"pre-grasp {_both(md['pregrasp_E0'], pm['pregrasp'])} points."]
     if a.get("interior"):
-        L += ["## Ablation: the interior observation (ours) versus the paper's observations (PLM)",
-              "", "`interior_seen`: the camera saw the object's inside through a wide opening "
+        L += ["", "## Ablation: the interior observation (ours) versus the paper's observations "
+              "(PLM)", "", "`interior_seen`: the camera saw the object's inside through a wide "
+              "opening "
               "(tg_drake/perception/pose.py `interior_seen`; perfect on S_SYN: an open container "
               "not upside down); the theory rules out cans and bottles "
               "(rules/category_*.pl). The paper has no such observation.", "",
