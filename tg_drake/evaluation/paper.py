@@ -21,7 +21,7 @@ from dataclasses import dataclass
 @dataclass(frozen=True)
 class Figure:
     key: tuple[str, ...]  # (measure, row, column[, ...]): the path in PAPER
-    value: float
+    value: float  # an int for a count or another whole number of unit ""
     unit: str  # "%", "ms", "" (a count, a rank or a parameter)
     source: str  # the paper's table label or passage ("VI-C-2 text"), the measure, row and column
 
@@ -37,8 +37,8 @@ def _table(measure: str, source: str, cells: dict, unit: str = "%", _key=()) -> 
             _table(measure, source, cell, unit, key)
         else:
             where = ", ".join(f"{what} {k}" for what, k in zip(("row", "column", "entry"), key))
-            FIGURES.append(Figure((measure, *key), float(cell), unit,
-                                  f"{source}: {measure}, {where}"))
+            value = int(cell) if unit == "" and float(cell).is_integer() else float(cell)
+            FIGURES.append(Figure((measure, *key), value, unit, f"{source}: {measure}, {where}"))
 
 
 # -- Section VI-A: the datasets ---------------------------------------------------------------

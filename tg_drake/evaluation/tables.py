@@ -16,6 +16,7 @@ through the lift, over the runs whose planner found a grasp to execute.
 
 from __future__ import annotations
 
+import re
 from collections import defaultdict
 
 import numpy as np
@@ -393,6 +394,11 @@ def _both(ours, paper) -> str:
     return f"**{_f(ours)}** ({_f(paper)})" if paper is not None else f"**{_f(ours)}**"
 
 
+def _text(lines: list[str]) -> str:
+    """The page, one blank line between blocks (a section left out leaves no gap)."""
+    return re.sub(r"\n{3,}", "\n\n", "\n".join(lines)).rstrip("\n") + "\n"
+
+
 def markdown(t: dict, *, command: str, notes: str = "") -> str:
     P = PAPER
     def name(d):
@@ -437,11 +443,11 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
         f"{DATASETS[d]}{' datasets' if d == 'real' else ''} {_f(v['plm_uniform'])} and "
         f"{_f(v['plm_general_uniform'])}" for d, v in P["category_ties_ok"].items())
         + "). In executed suites PLM is the pipeline's logic and PLM_uniform the "
-        "pipeline_uniform variant's; Manifolds is the pipeline's kernel prior. "
-        + " ".join(f"{name(d)}: Label fractions and Manifolds over its {r['n_objects']} objects "
-                   f"(one prior per object, as the paper's 36 of 41), the PLM columns over its "
-                   f"{r['n']} cases." for d, r in t["category"].items()
-                   if r.get("n_objects") and r["n_objects"] != r.get("n"))]
+        "pipeline_uniform variant's; Manifolds is the pipeline's kernel prior."
+        + "".join(f" {name(d)}: Label fractions and Manifolds over its {r['n_objects']} objects "
+                  f"(one prior per object, as the paper's 36 of 41), the PLM columns over its "
+                  f"{r['n']} cases." for d, r in t["category"].items()
+                  if r.get("n_objects") and r["n_objects"] != r.get("n"))]
     impossible = {d: v for d, v in t.get("impossible_evidence", {}).items() if v}
     L += ["", "Cases whose observations are impossible under a method's theory (a kernel prior "
           "certain of a category the observed parts rule out), counted as failures: "
@@ -459,8 +465,9 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
         L += ["", "## Task (paper Table \"task_plm_e0\" and Fig. \"task_plm\"; task inferred)", ""]
     for d, r in t["task"].items():
         ks = list(r["plm"])
-        L += [f"{name(d)} ({r['n']} scenarios; ground-truth task sets of size "
-              + ", ".join(f"{k}: {v}" for k, v in r.get("gt_sizes", {}).items()) + "):", "",
+        sizes = ", ".join(f"{k}: {v}" for k, v in r.get("gt_sizes", {}).items())
+        L += [f"{name(d)} ({r['n']} scenarios" + (f"; ground-truth task sets of size {sizes}"
+                                                  if sizes else "") + "):", "",
               "| method | " + " | ".join(ks) + " |", "|---|" + "---|" * len(ks)]
         for m in LOGIC_METHODS:
             L.append(f"| {LABELS[m]} | " + " | ".join(
@@ -553,7 +560,7 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
 
     a = t["ablations"]
     if not a["top_category"]:
-        return "\n".join(L) + "\n"
+        return _text(L)
     L += ["", "## Ablation: the top category only versus the full prior (PLM)", "",
           "| dataset | category full | top only | task E0 full | top only | pre-grasp E0 full | "
           "top only |", "|---|---|---|---|---|---|---|"]
@@ -589,4 +596,4 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
                      f"{_f(w['task_E0'])} | {_f(o['task_E0'])} | {_f(w['pregrasp_E0'])} | "
                      f"{_f(o['pregrasp_E0'])} |")
         L.append("")
-    return "\n".join(L)
+    return _text(L)
