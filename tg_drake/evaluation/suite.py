@@ -11,9 +11,11 @@ A suite is of one kind:
   kept; S_REAL_noisy: perceived pose likelihood and part likelihoods).
 - "executed": scenarios run end to end in simulation (`tg_drake.run.run_scenario`), in variants
   "pipeline" (kernel prior + logic + DGI), "pipeline_uniform" (uniform category prior) and "local"
-  (hypotheses ranked by the DGI's P(grasp | local shape) alone): S_GRASP and S_ROBOT.
+  (hypotheses ranked by the DGI's P(grasp | local shape) alone): S_GRASP and S_ROBOT, and the
+  single-object sweep (dataset "sweep", ours).
 
-Cases come from a `generator` (objects × poses × containments × yaws × tasks) or from `scenes`
+Cases come from a `generator` (objects × poses × containments × yaws × tasks, or `sample` cases
+drawn from that product with the suite's seed, moved and turned at random) or from `scenes`
 (explicit multi-object scenes, each with variations). Ground truth is set-valued, as in the paper:
 a generated case takes its task set and its acceptable pre-grasp parts from the tables of the
 `ground_truth` file named by the suite (each table says where it comes from); a scene carries its
