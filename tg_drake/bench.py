@@ -22,7 +22,7 @@ FIGURES: dict[str, str] = {
     "kernel_query_ms": "tg_drake.kernels.bench:kernel_query_ms",
     "kernel_loo_s": "tg_drake.kernels.bench:kernel_loo_s",
     "logic_scene_ms": "tg_drake.logic.bench:logic_scene_ms",
-    "perception_ms": "tg_drake.perception.bench:perception_ms",
+    "perception_ms": "tg_drake.evaluation.bench:perception_ms",
     "segmentation_ms": "tg_drake.perception.bench:segmentation_ms",
     "dgi_us_per_hypothesis": "tg_drake.grasping.bench:dgi_us_per_hypothesis",
     "sweep_efficiency": "tg_drake.evaluation.bench:sweep_efficiency",

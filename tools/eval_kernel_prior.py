@@ -38,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tg_drake.evaluation.paper import PAPER
 from tg_drake.kernels.database import ENTRIES, KernelDatabase, load_database
 from tg_drake.kernels.evaluation import (
     QUERY_YAWS_DEG, Score, best, evaluate_members, leave_one_object_out,
@@ -50,15 +51,15 @@ from tg_drake.objects import load_library
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
 SHIPPED = Path(__file__).resolve().parents[1] / "tg_drake" / "data" / "kernel_db.npz"
 
-# The paper's Table (object category) and text: accuracy [%] and mean rank of the true category.
-PAPER = {
-    "syn": {"random": {"accuracy": 9.1, "mean_rank": 5.5},
-            "label_fractions": {"accuracy": 63.4, "mean_rank": 1.88, "T": 0},
-            "manifolds": {"accuracy": 87.8, "mean_rank": 1.39, "T": 12, "T_rank": 13}},
-    "perceived": {"random": {"accuracy": 9.1, "mean_rank": 5.5},
-                  "label_fractions": {"accuracy": 39.7, "mean_rank": 2.54, "T": 0},
-                  "manifolds": {"accuracy": 39.7, "mean_rank": 2.45, "T": 0, "T_rank": 3}},
-}
+def paper_figures(row: str) -> dict:
+    """The paper's accuracy [%], mean rank and T of Random, Label fractions and Manifolds for
+    S_SYN ("syn") or the S_REAL datasets ("real"), from tg_drake.evaluation.paper."""
+    out = {m: {"accuracy": PAPER["category"][row][m], "mean_rank": PAPER["mean_rank"][row][m]}
+           for m in ("random", "label_fractions", "manifolds")}
+    out["label_fractions"]["T"] = 0
+    out["manifolds"]["T"] = int(PAPER["kernel_T"][row]["manifolds_accuracy"])
+    out["manifolds"]["T_rank"] = int(PAPER["kernel_T"][row]["manifolds_rank"])
+    return out
 
 
 # The perceived figures of the database shipped before it held perceived views (commit 5514202:
@@ -180,7 +181,7 @@ def _pct(x: float) -> str:
 
 
 def markdown(result: dict) -> str:
-    syn, paper, pp = result["syn"], PAPER["syn"], PAPER["perceived"]
+    syn, paper, pp = result["syn"], paper_figures("syn"), paper_figures("real")
     perceived, shipped = result.get("perceived"), result["shipped_database"]
     lines = [
         "# Kernel category prior (paper section III-C, Table \"object category\")",
@@ -367,7 +368,7 @@ def main(argv=None) -> int:
         "syn": syn,
         "perceived": perceived,
         "syn_shipped": syn_shipped_scores(db),
-        "paper": PAPER,
+        "paper": {"syn": paper_figures("syn"), "perceived": paper_figures("real")},
         "shipped_database": {**shipped_query_times(db, n_timed),
                              "n_ground_truth": int(np.sum(db.sources == "ground_truth")),
                              "n_perceived": int(np.sum(db.sources == "perceived")),

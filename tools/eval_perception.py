@@ -36,6 +36,8 @@ from typing import Iterable, Iterator
 import numpy as np
 
 from tg_drake.errors import PerceptionError
+from tg_drake.evaluation.paper import PAPER
+from tg_drake.evaluation.suite import DATASETS
 from tg_drake.perception.config import PerceptionConfig
 from tg_drake.perception.geometry import Intrinsics, inverse, make_transform, transform
 from tg_drake.perception.pipeline import describe_object
@@ -47,8 +49,6 @@ from tg_drake.perception.segmentation import segment_depth
 CAMERAS = {"front": (0.0, 55.0, 0.85), "left": (50.0, 40.0, 0.85), "right": (-50.0, 45.0, 0.85)}
 YAWS_DEG = (0.0, 90.0, 180.0, 270.0)
 WIDTH, HEIGHT, FOV_Y_DEG = 640, 480, 45.0  # the station's default camera
-PAPER = {"pose_accuracy": 1.0, "part_accuracy_grasp_noisy": 0.8456,
-         "part_accuracy_robot": 0.8214}
 
 
 @dataclass
@@ -244,7 +244,7 @@ def summarise(records: list[dict], seg_ms: list[float], obj_ms: list[float]) -> 
         failures=failures(records),
         timing_ms={"segmentation_median": statistics.median(seg_ms) if seg_ms else None,
                    "object_median": statistics.median(obj_ms) if obj_ms else None},
-        paper=PAPER)
+        paper={d: PAPER["detection"][d] for d in ("grasp", "robot")})
     return summary
 
 
@@ -265,8 +265,9 @@ def markdown(summary: dict, command: str, renderer: str) -> str:
         "",
         "| setting | views | pose [%] | parts [%] |",
         "|---|---:|---:|---:|",
-        "| paper, S_GRASP_noisy (upright, sideways) | – | 100 | 84.56 |",
-        "| paper, S_ROBOT (upright, sideways) | – | 100 | 82.14 |",
+        *(f"| paper, {DATASETS[d]} (upright, sideways) | – | "
+          f"{PAPER['detection'][d]['pose_accuracy']:g} | "
+          f"{PAPER['detection'][d]['part_accuracy']:g} |" for d in ("grasp", "robot")),
         f"| ours, upright and sideways | {us['n_views']} | {pct(us['pose_accuracy'])} | "
         f"{pct(us['part_accuracy'])} |",
         f"| ours, all suitable poses (with upside-down) | {summary['n_views']} | "
@@ -296,11 +297,12 @@ def markdown(summary: dict, command: str, renderer: str) -> str:
     for f in summary.get("failures", []):
         lines.append(f"| {f['object']} | {f['pose']} | {f['found_pose']} | {f['found_parts']} | "
                      f"{f['views']} |")
-    t = summary["timing_ms"]
+    t, ms = summary["timing_ms"], PAPER["detection_ms"]
     lines += ["", "Median time per view during this run: segmentation "
               f"{t['segmentation_median']:.1f} ms (640×480 frame), one object's completion + "
               "pose + parts "
-              f"{t['object_median']:.1f} ms (paper: 27.5 + 15.71 = 43.21 ms). The speed figures "
+              f"{t['object_median']:.1f} ms (paper: {ms['completion']:g} + {ms['pose']:g} = "
+              f"{ms['completion'] + ms['pose']:.2f} ms). The speed figures "
               "proper come from `tg-drake bench --only perception_ms --only segmentation_ms`.", ""]
     return "\n".join(lines)
 

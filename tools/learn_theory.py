@@ -50,7 +50,7 @@ ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results"
 DATA = ROOT / "data" / "learning"
 RUN_TASK = "p&pOn"  # the task the collection runs ask for: every object affords it.
-PLACE_XY = [0.0, -0.3]  # table frame, as tools/eval_pipeline.py
+PLACE_XY = [0.0, -0.3]  # table frame, as scenarios/suites/sweep.yaml
 
 
 # ---- data collection ---------------------------------------------------------------------------

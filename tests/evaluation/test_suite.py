@@ -95,3 +95,31 @@ def test_bad_ground_truth_tables_are_named(tmp_path):
     (tmp_path / "gt.yaml").write_text(text.replace("    cup: &dish_tasks", "    mug: &dish_tasks"))
     with pytest.raises(ScenarioError, match=r"unknown category 'mug'; allowed: pan, pot"):
         load_suite(path)
+
+
+def test_the_sweep_draws_single_object_cases_with_the_categories_in_turn():
+    from tg_drake.objects import get_object
+    from tg_drake.types import CATEGORIES
+
+    suite, cases = load_suite(SUITES / "sweep.yaml")
+    assert suite.kind == "executed" and suite.dataset == "sweep" and len(cases) == 33
+    assert [get_object(c.target_placement.id).category for c in cases] == \
+        [CATEGORIES[i % len(CATEGORIES)] for i in range(33)]
+    assert len({c.key for c in cases}) == 33 and all(len(c.objects) == 1 for c in cases)
+    for c in cases:
+        p = c.target_placement
+        assert abs(p.xy[0]) <= 0.08 and abs(p.xy[1]) <= 0.12 and 0 <= p.yaw < 360
+        assert c.task in c.truth.tasks and c.task in ("pass", "p&pOn", "p&pInUpright")
+    assert len({c.target_placement.yaw for c in cases}) > 20  # turned, not all at one yaw
+    assert load_suite(SUITES / "sweep.yaml")[1] == cases  # the suite's seed fixes the draw
+
+
+@pytest.mark.parametrize("generator, message", [
+    ("{sample: -1}", r"field 'generator.sample': sample is a number of cases"),
+    ("{xy_spread: [0.1, 0.0]}", r"xy_spread and yaw_spread vary drawn cases only"),
+])
+def test_bad_sampling_settings_are_named(tmp_path, generator, message):
+    path = write(tmp_path, f"kind: synthetic\ndataset: syn\nground_truth: ground_truth.yaml\n"
+                           f"generator: {generator}\n")
+    with pytest.raises(ScenarioError, match=message):
+        load_suite(path)

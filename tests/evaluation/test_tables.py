@@ -72,3 +72,23 @@ def test_e_i_measure():
     assert not e_success(p, {0, 1, 3}, 0)  # the third prediction (2) is not in Gt
     assert e_success(p, {0, 1, 3}, 1)
     assert not e_success(np.zeros(4), {0}, 0)
+
+
+def test_a_synthetic_prior_counts_once_per_object():
+    """S_SYN priors are one per object (the paper's Manifolds is over its 41 objects): a second
+    case of the cup, whatever its prior, does not count again for Label fractions or Manifolds;
+    the logic columns count every case."""
+    cup = next(r for r in RECORDS if r["job"] == "small/cup")
+    again = json.loads(json.dumps(cup))
+    again["job"], again["pose"] = "small/cup_sideways", "sideways"
+    again["priors"]["manifolds"] = [1.0] + [0.0] * 10  # a pan: wrong
+    syn = compute(RECORDS + [again])["category"]["syn"]
+    assert syn["n_objects"] == 2 and syn["n"] == 3 and syn["manifolds"] == 100.0
+    assert syn["plm"] == round(100 * 2 / 3, 2)  # the cup's PLM answer counts for both cases
+
+
+def test_outcomes_over_all_runs(tables):
+    o = tables["outcomes"]["grasp"]["pipeline"]
+    assert (o["n"], o["grasped"], o["lifted"], o["placed"]) == (2, 50.0, 50.0, 50.0)
+    assert o["failures"] == {"missed": 1}
+    assert sum(row["n"] for row in o["per_category"].values()) == 2

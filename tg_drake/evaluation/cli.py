@@ -6,13 +6,15 @@
 Writes, in DIR: `results.jsonl` (one line per case as it finishes — perceived cases one per
 setting; a rerun skips finished cases; a crashed case is recorded as an error and counts as a
 failure), then `tables.json`, `tables.md` and PNG plots derived from every record of the suites
-given. `--tables-only` derives the tables from the records already there.
+given (`--name logic`: logic.json, logic.md, logic_*.png). `--tables-only` derives the tables
+from the records already there.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import re
 import shlex
 import sys
 import zlib
@@ -41,6 +43,9 @@ def add_arguments(parser) -> None:
                         help="run again the cases recorded as errors")
     parser.add_argument("--tables", type=Path, default=None,
                         help="folder for tables.json, tables.md and the plots (default: --out)")
+    parser.add_argument("--name", default="tables",
+                        help="file stem of the tables (NAME.json, NAME.md) and, unless 'tables', "
+                             "prefix of the plots (NAME_accuracy.png, ...)")
     parser.add_argument("--tables-only", action="store_true",
                         help="only derive the tables and plots from DIR/results.jsonl")
 
@@ -111,21 +116,27 @@ def read_records(out: Path, cases) -> list[dict]:
     return records
 
 
-def write_tables(out_dir: Path, records: list[dict], command: str, notes: str = "") -> dict:
+def write_tables(out_dir: Path, records: list[dict], command: str, notes: str = "",
+                 name: str = "tables") -> dict:
     from tg_drake.evaluation.plots import save_plots
     from tg_drake.evaluation.tables import compute, markdown
 
     tables = compute(records)
     tables["command"] = command
-    (out_dir / "tables.json").write_text(json.dumps(tables, indent=1) + "\n")
-    (out_dir / "tables.md").write_text(markdown(tables, command=command, notes=notes))
-    save_plots(tables, out_dir)
+    (out_dir / f"{name}.json").write_text(json.dumps(tables, indent=1) + "\n")
+    (out_dir / f"{name}.md").write_text(markdown(tables, command=command, notes=notes))
+    save_plots(tables, out_dir, prefix="" if name == "tables" else f"{name}_")
     return tables
 
 
 def main(args) -> int:
     from tg_drake.executor import Job, make_executor, run_jobs
 
+    if not re.fullmatch(r"[\w.-]+", args.name):
+        from tg_drake.errors import ScenarioError
+
+        raise ScenarioError(f"--name is a file stem (letters, digits, '_', '-', '.'), got "
+                            f"{args.name!r}", field="--name")
     cases = load_cases(args.suites)
     if args.theory != "specific":
         from tg_drake.errors import ScenarioError, unknown_name
@@ -159,8 +170,8 @@ def main(args) -> int:
     coverage = (f"Cases with records: {len(done)} of {len(cases)} ("
                 + ", ".join(f"{s} {a}/{b}" for s, (a, b) in per_suite.items()) + ").")
     tables = write_tables(folder, records, command,
-                          notes=suite_notes(args.suites) + "\n\n" + coverage)
-    print(f"{len(done)} of {len(cases)} cases have records; tables in {folder}/tables.md "
+                          notes=suite_notes(args.suites) + "\n\n" + coverage, name=args.name)
+    print(f"{len(done)} of {len(cases)} cases have records; tables in {folder}/{args.name}.md "
           f"({tables['n_errors']} crashed cases counted as failures)")
     return 0
 

@@ -6,7 +6,7 @@ table can be derived again from the records (tg_drake.evaluation.tables).
 
 - synthetic: observations from the labelled mesh (parts certain, pose certain, containment, handle
   count); kernel priors at T = 0 (Label fractions) and T = kernel_T (Manifolds) from one labelled
-  sampling of the mesh, leave-one-object-out; then every logic method (METHODS) answers category,
+  sampling of the mesh per object (seeded by the object and the suite's seed), leave-one-object-out; then every logic method (METHODS) answers category,
   task (inferred) and, for each ground-truth task given, the pre-grasp part.
 - perceived: the object's depth image ray cast from the default camera's viewpoint and perceived;
   pose and part detection against the truth; then the same queries on observations of each setting.
@@ -127,8 +127,10 @@ def run_synthetic(case) -> dict:
     obj = get_object(placement.id)
     vertices, _, labels = mesh(obj)
     handles = handle_count(vertices, labels) if "handle" in obj.parts else 1
+    # One labelled sampling per object, whatever its pose and containment (the paper's S_SYN has
+    # one point cloud per object, so its Manifolds accuracy is over objects: 36 of 41 = 87.8 %).
     cloud = sample_object(obj, spacing=load_database().spacing,
-                          rng=np.random.default_rng(_seed(case.key, case.seed)))
+                          rng=np.random.default_rng(_seed(obj.id, case.seed)))
     observations = Observations(parts={p: 1.0 for p in obj.parts}, pose={placement.pose: 1.0},
                                 containment={placement.containment: 1.0}, handles=handles,
                                 interior_seen=interior_visible(obj.id, placement.pose))

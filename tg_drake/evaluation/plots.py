@@ -12,7 +12,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from tg_drake.evaluation.suite import DATASETS
-from tg_drake.evaluation.tables import CATEGORY_METHODS, LABELS, PAPER, THRESHOLDS
+from tg_drake.evaluation.paper import PAPER
+from tg_drake.evaluation.tables import CATEGORY_METHODS, LABELS, THRESHOLDS
 
 DPI = 80  # small files for the repository
 
@@ -101,19 +102,20 @@ def pipeline_plot(tables: dict, path: Path) -> None:
     plt.close(fig)
 
 
-def save_plots(tables: dict, folder: Path) -> list[Path]:
+def save_plots(tables: dict, folder: Path, prefix: str = "") -> list[Path]:
+    """The plots that have data, as `<prefix><name>.png` in `folder`."""
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
     if tables["category"]:
-        accuracy_plot(tables, folder / "accuracy.png")
-        paths.append(folder / "accuracy.png")
+        accuracy_plot(tables, folder / f"{prefix}accuracy.png")
+        paths.append(folder / f"{prefix}accuracy.png")
     for key, title in (("task", "Task prediction over E_i (task inferred)"),
                        ("pregrasp", "Pre-grasp prediction over E_i (task given)")):
-        path = folder / f"{key}_ei.png"
+        path = folder / f"{prefix}{key}_ei.png"
         ei_plot(tables, key, path, title)
         if path.exists():
             paths.append(path)
-    path = folder / "pipeline_vs_local.png"
+    path = folder / f"{prefix}pipeline_vs_local.png"
     pipeline_plot(tables, path)
     if path.exists():
         paths.append(path)

@@ -11,9 +11,11 @@ A suite is of one kind:
   kept; S_REAL_noisy: perceived pose likelihood and part likelihoods).
 - "executed": scenarios run end to end in simulation (`tg_drake.run.run_scenario`), in variants
   "pipeline" (kernel prior + logic + DGI), "pipeline_uniform" (uniform category prior) and "local"
-  (hypotheses ranked by the DGI's P(grasp | local shape) alone): S_GRASP and S_ROBOT.
+  (hypotheses ranked by the DGI's P(grasp | local shape) alone): S_GRASP and S_ROBOT, and the
+  single-object sweep (dataset "sweep", ours).
 
-Cases come from a `generator` (objects × poses × containments × yaws × tasks) or from `scenes`
+Cases come from a `generator` (objects × poses × containments × yaws × tasks, or `sample` cases
+drawn from that product with the suite's seed, moved and turned at random) or from `scenes`
 (explicit multi-object scenes, each with variations). Ground truth is set-valued, as in the paper:
 a generated case takes its task set and its acceptable pre-grasp parts from the tables of the
 `ground_truth` file named by the suite (each table says where it comes from); a scene carries its
@@ -36,7 +38,9 @@ SETTINGS = ("semi", "real", "noisy")  # perceived suites: the paper's S_REAL_sem
 VARIANTS = ("pipeline", "pipeline_uniform", "local")  # executed suites
 # dataset label → the paper's name (rows of the section VI tables).
 DATASETS = {"syn": "S_SYN", "real_semi": "S_REAL_semi", "real": "S_REAL",
-            "real_noisy": "S_REAL_noisy", "grasp": "S_GRASP_noisy", "robot": "S_ROBOT"}
+            "real_noisy": "S_REAL_noisy", "grasp": "S_GRASP_noisy", "robot": "S_ROBOT",
+            "sweep": "Sweep"}
+OURS = ("sweep",)  # datasets of ours, not analogues of the paper's (no paper figures)
 DATASET_OF_SETTING = {"semi": "real_semi", "real": "real", "noisy": "real_noisy"}
 CLASSES = ("dish", "kitchen_container", "canister", "tool")  # rules/README.md tables 1 and 5
 
@@ -83,6 +87,12 @@ class Generator:
     # ground-truth task.
     place_xy: list[float] = field(default_factory=lambda: [0.0, -0.3])  # [m] table frame
     max_grasp_width: float = math.inf  # [m] objects whose every part is wider are left out
+    sample: int = 0  # 0: every case of the product; N > 0: N cases drawn from it with the suite's
+    # seed, the chosen objects' categories in turn (an object, pose, containment, yaw and task each)
+    xy_spread: list[float] = field(default_factory=lambda: [0.0, 0.0])  # [m] a drawn case's xy
+    # is `xy` plus a uniform offset within ± these (table frame)
+    yaw_spread: float = 0.0  # [deg] a drawn case's yaw is one of `yaws` plus a uniform offset in
+    # [0, yaw_spread)
 
 
 @dataclass
@@ -301,6 +311,12 @@ def _generated(suite: Suite, gt: GroundTruthTables, where: str, gt_where: str) -
         if t not in TASKS:
             raise unknown_name("task", t, TASKS, error=ScenarioError, file=where,
                                field="generator.tasks")
+    if g.sample < 0:
+        raise ScenarioError(f"sample is a number of cases (0 = the whole product), got "
+                            f"{g.sample}", file=where, field="generator.sample")
+    if not g.sample and (any(g.xy_spread) or g.yaw_spread):
+        raise ScenarioError("xy_spread and yaw_spread vary drawn cases only: set `sample`",
+                            file=where, field="generator.sample")
     seen, cases = set(), []
     for obj in chosen:
         if obj.id in seen or obj.id in g.exclude:
@@ -330,6 +346,41 @@ def _generated(suite: Suite, gt: GroundTruthTables, where: str, gt_where: str) -
                                 key, suite.name, suite.kind, suite.dataset, (placement,),
                                 placement.instance_name, task, tuple(g.place_xy), truth,
                                 variant, tuple(suite.settings), suite.kernel_T, suite.seed))
+    return _drawn(suite, cases, library) if g.sample else cases
+
+
+def _drawn(suite: Suite, product: list[Case], library) -> list[Case]:
+    """`generator.sample` cases drawn from the product with the suite's seed: categories in turn,
+    then a case of that category (its variants together), moved by the spreads."""
+    import dataclasses
+
+    import numpy as np
+
+    g = suite.generator
+    rng = np.random.default_rng(suite.seed)
+    by_scenario: dict[str, list[Case]] = {}
+    for c in product:  # a scenario's variants side by side
+        by_scenario.setdefault(c.key.split("@")[0], []).append(c)
+    by_category: dict[str, list[list[Case]]] = {}
+    for variants in by_scenario.values():
+        category = library[variants[0].target_placement.id].category
+        by_category.setdefault(category, []).append(variants)
+    categories = [c for c in CATEGORIES if c in by_category]
+    cases = []
+    for i in range(g.sample):
+        variants = by_category[categories[i % len(categories)]]
+        chosen = variants[int(rng.integers(len(variants)))]
+        p = chosen[0].target_placement
+        dx, dy = (rng.uniform(-1.0, 1.0, size=2) * np.asarray(g.xy_spread, dtype=float)).tolist()
+        placement = dataclasses.replace(
+            p, xy=[round(p.xy[0] + dx, 3), round(p.xy[1] + dy, 3)],
+            yaw=round(p.yaw + float(rng.uniform(0.0, g.yaw_spread)), 1))
+        name = f"{i:03d}_{p.id}_{p.pose}_{p.containment}" + (f"_{chosen[0].task}"
+                                                              if chosen[0].task else "")
+        for c in chosen:
+            cases.append(dataclasses.replace(
+                c, key=f"{suite.name}/{name}" + (f"@{c.variant}" if c.variant else ""),
+                objects=(placement,)))
     return cases
 
 

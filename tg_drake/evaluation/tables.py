@@ -16,11 +16,13 @@ through the lift, over the runs whose planner found a grasp to execute.
 
 from __future__ import annotations
 
+import re
 from collections import defaultdict
 
 import numpy as np
 
-from tg_drake.evaluation.suite import DATASETS
+from tg_drake.evaluation.paper import PAPER
+from tg_drake.evaluation.suite import DATASETS, OURS, VARIANTS
 from tg_drake.types import CATEGORIES, PART_LABELS, TASKS
 
 TIE = 1e-9  # probabilities this close are tied (the circuit's rounding is ~1e-15; records keep 6 digits)
@@ -35,73 +37,6 @@ LABELS = {"random": "Random", "label_fractions": "Label fractions", "manifolds":
           "plm_nonexclusive": "PLM, not mutually exclusive",
           "plm_paper_observations": "PLM, the paper's observations only", "local": "Local",
           "pipeline": "Pipeline", "pipeline_uniform": "Pipeline_uniform"}
-
-# The paper's figures [%], section VI (table labels in the paper's LaTeX).
-PAPER = {
-    # tab:visualRepresentation
-    "detection": {"grasp": {"part_accuracy": 84.56, "pose_accuracy": 100.0},
-                  "robot": {"part_accuracy": 82.14, "pose_accuracy": 100.0}},
-    # tab:object_category_graphkernel (and the text for "ties ok")
-    "category": {
-        "syn": {"random": 9.1, "label_fractions": 63.4, "manifolds": 87.8, "plm_uniform": 31.37,
-                "plm_general_uniform": 31.37, "plm": 93.14, "plm_general": 92.16},
-        "real_semi": {"random": 9.1, "label_fractions": 39.7, "manifolds": 39.7,
-                      "plm_uniform": 14.29, "plm_general_uniform": 14.29, "plm": 49.21,
-                      "plm_general": 46.83},
-        "real": {"random": 9.1, "label_fractions": 39.7, "manifolds": 39.7, "plm_uniform": 14.29,
-                 "plm_general_uniform": 14.29, "plm": 48.41, "plm_general": 46.83},
-        "real_noisy": {"random": 9.1, "label_fractions": 39.7, "manifolds": 39.7,
-                       "plm_uniform": 14.29, "plm_general_uniform": 14.29, "plm": 39.7,
-                       "plm_general": 39.7},
-        "grasp": {"random": 9.1, "manifolds": 37.95},
-        "robot": {"random": 9.1, "manifolds": 50.0},
-    },
-    "category_ties_ok": {"syn": {"plm_uniform": 99.02, "plm_general_uniform": 94.12},
-                         "real": {"plm_uniform": 68.25, "plm_general_uniform": 62.70}},
-    # tab:task_plm_e0 (E_0; S_GRASP and S_ROBOT also E_1)
-    "task": {
-        "syn": {"plm_uniform": 71.57, "plm_general_uniform": 65.69, "plm": 72.55,
-                "plm_general": 72.55},
-        "real_semi": {"plm_uniform": 98.41, "plm_general_uniform": 98.41, "plm": 95.24,
-                      "plm_general": 93.65},
-        "real": {"plm_uniform": 80.16, "plm_general_uniform": 80.16, "plm": 95.24,
-                 "plm_general": 93.65},
-        "real_noisy": {"plm_uniform": 38.10, "plm_general_uniform": 38.10, "plm": 93.65,
-                       "plm_general": 93.65},
-    },
-    # tab:pregrasp_taskgiven_e0 (task given, E_0)
-    "pregrasp": {
-        "syn": {"plm_uniform": 81.23, "plm_general_uniform": 80.67, "plm": 85.29,
-                "plm_general": 84.73},
-        "real_semi": {"plm_uniform": 69.95, "plm_general_uniform": 72.00, "plm": 85.26,
-                      "plm_general": 86.73},
-        "real": {"plm_uniform": 72.00, "plm_general_uniform": 72.00, "plm": 85.26,
-                 "plm_general": 84.69},
-        "real_noisy": {"plm_uniform": 69.16, "plm_general_uniform": 69.16, "plm": 85.49,
-                       "plm_general": 86.73},
-        "grasp": {"pipeline_uniform": 66.7, "pipeline": 75.51},
-        "robot": {"pipeline_uniform": 66.7, "pipeline": 66.7},
-    },
-    # tab:pipeline: share of successful grasps with P(grasp | local shape) below a threshold
-    "pipeline_vs_local": {
-        "grasp": {"local": {"0.5": 44.55, "0.4": 27.27, "0.3": 4.55},
-                  "pipeline": {"0.5": 52.38, "0.4": 28.57, "0.3": 7.94},
-                  "pipeline_uniform": {"0.5": 50.0, "0.4": 21.15, "0.3": 7.69}},
-        "robot": {"local": {"0.5": 37.5, "0.4": 25.0, "0.3": 12.5},
-                  "pipeline": {"0.5": 50.0, "0.4": 42.86, "0.3": 28.57},
-                  "pipeline_uniform": {"0.5": 46.15, "0.4": 23.08, "0.3": 23.08}},
-    },
-    # tab:realRobotGlobalStats: scenario1-3 = 2, 3, 4 objects
-    "grasp_and_place": {"2": {"total": 10, "reachable": 90.0, "grasped": 77.8, "placed": 77.8},
-                        "3": {"total": 15, "reachable": 66.7, "grasped": 70.0, "placed": 70.0},
-                        "4": {"total": 20, "reachable": 80.0, "grasped": 50.0, "placed": 50.0}},
-    # section VI-C text: only the top category fed to the PLM (S_REAL_semi, S_REAL, noisy)
-    "top_category": {"task": {"real_semi": 95.24, "real": 89.68, "real_noisy": 89.68},
-                     "pregrasp": {"real_semi": 81.63, "real": 81.63, "real_noisy": 82.88}},
-    # section VI-C text: mean (exclusive − non-exclusive) over the datasets
-    "exclusive_minus_nonexclusive": {"category": 1.6, "task": 8.5, "pregrasp": 2.6},
-}
-
 
 def top_set(p: np.ndarray) -> set[int]:
     """Indices tied at the maximum (empty when everything is 0)."""
@@ -180,6 +115,54 @@ def detection(records) -> dict:
     return out
 
 
+def _per_object(logic) -> list[dict]:
+    """Synthetic records: the first of each object (its prior is the object's); other kinds: all
+    (a perceived prior is one per view)."""
+    seen: dict = {}
+    for r in logic:
+        seen.setdefault(r["object"] if r.get("kind") == "synthetic" else r["job"] + str(
+            r.get("setting")), r)
+    return list(seen.values())
+
+
+def per_category(records) -> dict:
+    """Category accuracy (argmax, ties fail) per true category, for each logic dataset: the
+    kernel prior (Manifolds, per object as in `category`) and the logic methods."""
+    out = {}
+    for dataset, rs in _by_dataset(records).items():
+        logic = _logic(rs)
+        if not logic:
+            continue
+        table: dict = {}
+        for c in CATEGORIES:
+            mine = [r for r in logic if r["truth"]["category"] == c]
+            if not mine:
+                continue
+            i = CATEGORIES.index(c)
+            table[c] = {"n": len(mine), "manifolds": _pct([
+                r.get("priors") is not None and _argmax_ok(r["priors"]["manifolds"], i)
+                for r in _per_object(mine)])}
+            for m in LOGIC_METHODS:
+                table[c][m] = _pct([_method(r, m) is not None and
+                                    _argmax_ok(_method(r, m)["category"], i) for r in mine])
+        out[dataset] = table
+    return out
+
+
+def impossible_evidence(records) -> dict:
+    """Per logic dataset and method: the cases whose observations have probability 0 under the
+    method's theory (a kernel prior certain of a category the observed parts rule out); they
+    count as failures of every measure."""
+    out = {}
+    for dataset, rs in _by_dataset(records).items():
+        counts = {m: sum(1 for r in _logic(rs)
+                             if "error" in ((r.get("methods") or {}).get(m) or {}))
+                  for m in (*LOGIC_METHODS, *ABLATION_METHODS)}
+        if _logic(rs):
+            out[dataset] = {m: n for m, n in counts.items() if n}
+    return out
+
+
 def category(records) -> dict:
     out = {}
     for dataset, rs in _by_dataset(records).items():
@@ -187,9 +170,14 @@ def category(records) -> dict:
         logic = _logic(rs)
         if logic:
             truth = [CATEGORIES.index(r["truth"]["category"]) for r in logic]
+            # A synthetic prior is one per object (one labelled sampling of its mesh), so its
+            # accuracy is over the objects, as the paper's S_SYN Manifolds (36 of 41 objects).
+            objects = _per_object(logic)
+            table["n_objects"] = len(objects)
             for prior in ("label_fractions", "manifolds"):
-                table[prior] = _pct([r.get("priors") is not None and
-                                     _argmax_ok(r["priors"][prior], t) for r, t in zip(logic, truth)])
+                table[prior] = _pct([r.get("priors") is not None and _argmax_ok(
+                    r["priors"][prior], CATEGORIES.index(r["truth"]["category"]))
+                    for r in objects])
             for m in (*LOGIC_METHODS, *ABLATION_METHODS):
                 table[m] = _pct([_method(r, m) is not None and
                                  _argmax_ok(_method(r, m)["category"], t)
@@ -228,7 +216,8 @@ def task(records) -> dict:
         if not logic:
             continue
         n_i = _max_i(logic, "task") + 1
-        table = {"n": len(logic)}
+        sizes = [len(r["truth"]["tasks"]) for r in logic]
+        table = {"n": len(logic), "gt_sizes": {str(k): sizes.count(k) for k in sorted(set(sizes))}}
         for m in (*LOGIC_METHODS, *ABLATION_METHODS):
             table[m] = {}
             for i in range(n_i):
@@ -306,9 +295,12 @@ def pipeline_vs_local(records) -> dict:
 
 
 def grasp_and_place(records) -> dict:
+    """The paper's table per number of objects, over its datasets' analogues (ours, e.g. the
+    sweep, are in `outcomes`)."""
     by_n: dict = defaultdict(list)
     for r in _executed(records, "pipeline"):
-        by_n[str(r["n_objects"])].append(r)
+        if r["dataset"] not in OURS:
+            by_n[str(r["n_objects"])].append(r)
     out = {}
     for n, rs in sorted(by_n.items()):
         reachable = [r for r in rs if r.get("grasp")]
@@ -321,6 +313,31 @@ def grasp_and_place(records) -> dict:
         for k in ("grasped", "placed"):
             out[n][f"{k}_pct"] = (round(100.0 * out[n][k] / len(reachable), 2)
                                   if reachable else None)
+    return out
+
+
+def outcomes(records) -> dict:
+    """Executed runs per dataset and variant, over all runs: grasped (the object in the hand at
+    some point), lifted (held through the lift), placed; failures by reason; per category the
+    count of each outcome; median wall time per run [s]."""
+    reached = {"grasped": ("grasped", *HELD), "lifted": HELD, "placed": ("placed",)}
+    out: dict = {}
+    for dataset, rs in _by_dataset(records).items():
+        for variant in VARIANTS:
+            ex = _executed(rs, variant)
+            if not ex:
+                continue
+            per_category: dict = defaultdict(lambda: defaultdict(int))
+            for r in ex:
+                row = per_category[r["truth"]["category"]]
+                row["n"] += 1
+                row[_status(r) if "error" not in r else "error"] += 1
+            wall = [r["timings"]["total"] for r in ex if (r.get("timings") or {}).get("total")]
+            out.setdefault(dataset, {})[variant] = {
+                "n": len(ex), **{k: _pct([_status(r) in v for r in ex]) for k, v in reached.items()},
+                "failures": _failures(ex),
+                "per_category": {c: dict(per_category[c]) for c in CATEGORIES if c in per_category},
+                "wall_seconds_median": round(float(np.median(wall)), 2) if wall else None}
     return out
 
 
@@ -360,8 +377,10 @@ def compute(records: list[dict]) -> dict:
             "n_errors": sum("error" in r for r in records),
             "records_per_dataset": {d: dict(v) for d, v in counts.items()},
             "detection": detection(records), "category": cat, "task": tsk, "pregrasp": pre,
+            "per_category": per_category(records),
+            "impossible_evidence": impossible_evidence(records),
             "pipeline_vs_local": pipeline_vs_local(records),
-            "grasp_and_place": grasp_and_place(records),
+            "grasp_and_place": grasp_and_place(records), "outcomes": outcomes(records),
             "ablations": ablations(cat, tsk, pre), "paper": PAPER}
 
 
@@ -375,9 +394,16 @@ def _both(ours, paper) -> str:
     return f"**{_f(ours)}** ({_f(paper)})" if paper is not None else f"**{_f(ours)}**"
 
 
+def _text(lines: list[str]) -> str:
+    """The page, one blank line between blocks (a section left out leaves no gap)."""
+    return re.sub(r"\n{3,}", "\n\n", "\n".join(lines)).rstrip("\n") + "\n"
+
+
 def markdown(t: dict, *, command: str, notes: str = "") -> str:
     P = PAPER
-    name = lambda d: DATASETS.get(d, d) + " analogue"  # noqa: E731
+    def name(d):
+        return DATASETS.get(d, d) + ("" if d in OURS else " analogue")
+
     L = ["# The paper's section VI tables on our suites", "",
          f"Command: `{command}`", "",
          "Every number is derived from `results.jsonl` by `tg_drake.evaluation.tables` (accuracy "
@@ -392,9 +418,11 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
     L += [f"Records: {t['n_records']} ({t['n_errors']} crashed cases, counted as failures): "
           + ", ".join(f"{name(d)} {dict(v)}" for d, v in t["records_per_dataset"].items()), ""]
 
-    L += ["## Pose and part detection (paper Table \"visualRepresentation\")", "",
-          "| dataset | views | pose | parts | upright + sideways: pose | parts |",
-          "|---|---|---|---|---|---|"]
+    # A section whose table would be empty (no suite of its kind given) is left out.
+    if t["detection"]:
+        L += ["## Pose and part detection (paper Table \"visualRepresentation\")", "",
+              "| dataset | views | pose | parts | upright + sideways: pose | parts |",
+              "|---|---|---|---|---|---|"]
     for d, r in t["detection"].items():
         p = P["detection"].get(d, {})
         L.append(f"| {name(d)} | {r['n']} | {_f(r['pose_accuracy'])} | {_f(r['part_accuracy'])} "
@@ -411,14 +439,35 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
     L += ["", "Second definition (ties count as success) for the uniform prior: " + "; ".join(
         f"{name(d)}: PLM_uniform **{_f(r.get('plm_uniform_ties_ok'))}**, PLM^general_uniform "
         f"**{_f(r.get('plm_general_uniform_ties_ok'))}**" for d, r in t["category"].items()
-        if "plm_uniform_ties_ok" in r) + " (paper: S_SYN 99.02 and 94.12; S_REAL 68.25 and "
-        "62.70). In executed suites PLM is the pipeline's logic and PLM_uniform the "
-        "pipeline_uniform variant's; Manifolds is the pipeline's kernel prior."]
+        if "plm_uniform_ties_ok" in r) + " (paper: " + "; ".join(
+        f"{DATASETS[d]}{' datasets' if d == 'real' else ''} {_f(v['plm_uniform'])} and "
+        f"{_f(v['plm_general_uniform'])}" for d, v in P["category_ties_ok"].items())
+        + "). In executed suites PLM is the pipeline's logic and PLM_uniform the "
+        "pipeline_uniform variant's; Manifolds is the pipeline's kernel prior."
+        + "".join(f" {name(d)}: Label fractions and Manifolds over its {r['n_objects']} objects "
+                  f"(one prior per object, as the paper's 36 of 41), the PLM columns over its "
+                  f"{r['n']} cases." for d, r in t["category"].items()
+                  if r.get("n_objects") and r["n_objects"] != r.get("n"))]
+    impossible = {d: v for d, v in t.get("impossible_evidence", {}).items() if v}
+    L += ["", "Cases whose observations are impossible under a method's theory (a kernel prior "
+          "certain of a category the observed parts rule out), counted as failures: "
+          + ("; ".join(f"{name(d)}: " + ", ".join(f"{LABELS[m]} {n}" for m, n in v.items())
+                       for d, v in impossible.items()) or "none") + "."]
+    for d, r in t.get("per_category", {}).items():
+        ms = ("manifolds", *LOGIC_METHODS)
+        L += ["", f"{name(d)}, category accuracy per true category:", "",
+              "| category | cases | " + " | ".join(LABELS[m] for m in ms) + " |",
+              "|---|---|" + "---|" * len(ms)]
+        for c, row in r.items():
+            L.append(f"| {c} | {row['n']} | " + " | ".join(_f(row[m]) for m in ms) + " |")
 
-    L += ["", "## Task (paper Table \"task_plm_e0\" and Fig. \"task_plm\"; task inferred)", ""]
+    if t["task"]:
+        L += ["", "## Task (paper Table \"task_plm_e0\" and Fig. \"task_plm\"; task inferred)", ""]
     for d, r in t["task"].items():
         ks = list(r["plm"])
-        L += [f"{name(d)} ({r['n']} scenarios):", "",
+        sizes = ", ".join(f"{k}: {v}" for k, v in r.get("gt_sizes", {}).items())
+        L += [f"{name(d)} ({r['n']} scenarios" + (f"; ground-truth task sets of size {sizes}"
+                                                  if sizes else "") + "):", "",
               "| method | " + " | ".join(ks) + " |", "|---|" + "---|" * len(ks)]
         for m in LOGIC_METHODS:
             L.append(f"| {LABELS[m]} | " + " | ".join(
@@ -426,8 +475,9 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
                 for k in ks) + " |")
         L.append("")
 
-    L += ["## Pre-grasp (paper Table \"pregrasp_taskgiven_e0\" and Fig. "
-          "\"pregrasp_taskgiven_plm\"; task given)", ""]
+    if t["pregrasp"]:
+        L += ["## Pre-grasp (paper Table \"pregrasp_taskgiven_e0\" and Fig. "
+              "\"pregrasp_taskgiven_plm\"; task given)", ""]
     for d, r in t["pregrasp"].items():
         if "plm" in r:
             ks = list(r["plm"])
@@ -451,10 +501,12 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
                          f"{_f(x['E0_logic'])} |")
             L.append("")
 
-    L += ["## Pipeline versus local shape only (paper Table \"pipeline\")", "",
-          "Share of successful grasps (object held through the lift) whose P(grasp | local shape) "
-          "is below the threshold, on the scenarios every variant ran. Local ranks all hypotheses "
-          "by P(grasp | local shape) alone (`PipelineConfig.grasp_selection: local_only`).", ""]
+    if t["pipeline_vs_local"]:
+        L += ["## Pipeline versus local shape only (paper Table \"pipeline\")", "",
+              "Share of successful grasps (object held through the lift) whose P(grasp | local "
+              "shape) is below the threshold, on the scenarios every variant ran. Local ranks all "
+              "hypotheses by P(grasp | local shape) alone (`PipelineConfig.grasp_selection: "
+              "local_only`).", ""]
     for d, r in t["pipeline_vs_local"].items():
         vs = [v for v in ("local", "pipeline", "pipeline_uniform") if v in r]
         p = P["pipeline_vs_local"].get(d, {})
@@ -467,30 +519,57 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
                                                   for v in vs) + " |")
         L.append("")
 
-    L += ["## Grasp and place per scene complexity (paper Table \"realRobotGlobalStats\")", "",
-          "Pipeline variant; grasped and placed over the runs with a reachable pre-grasp, as the "
-          "paper.", "",
-          "| objects | runs | reachable pre-grasps | grasped | placed | not placed, by reason |",
-          "|---|---|---|---|---|---|"]
+    if t["grasp_and_place"]:
+        L += ["## Grasp and place per scene complexity (paper Table \"realRobotGlobalStats\")",
+              "", "Pipeline variant; grasped and placed over the runs with a reachable pre-grasp, "
+              "as the paper.", "",
+              "| objects | runs | reachable pre-grasps | grasped | placed | not placed, by "
+              "reason |", "|---|---|---|---|---|---|"]
     for n, r in t["grasp_and_place"].items():
-        p = P["grasp_and_place"].get(n, {})
+        p = P["grasp_and_place_pct"].get(n, {})
         L.append(f"| {n} ({', '.join(name(d) for d in r['datasets'])}) | {r['total']} "
-                 f"({_f(p.get('total'))}) | {r['reachable']} "
+                 f"({_f(P['grasp_and_place'].get(n, {}).get('total'))}) | {r['reachable']} "
                  f"{_both(r['reachable_pct'], p.get('reachable'))} | {r['grasped']} "
                  f"{_both(r['grasped_pct'], p.get('grasped'))} | {r['placed']} "
                  f"{_both(r['placed_pct'], p.get('placed'))} | "
                  + ", ".join(f"{k} {v}" for k, v in r["failures"].items()) + " |")
 
+    if t.get("outcomes"):
+        L += ["", "## Outcomes of the executed runs (ours)", "",
+              "Over all runs (the paper's table above counts grasped and placed over the runs "
+              "with a reachable pre-grasp): grasped = the object was in the hand, lifted = held "
+              "through the lift, placed.", "",
+              "| dataset | variant | runs | grasped | lifted | placed | not placed, by reason | "
+              "median wall time [s] |", "|---|---|---|---|---|---|---|---|"]
+        for d, by_variant in t["outcomes"].items():
+            for v, r in by_variant.items():
+                L.append(f"| {name(d)} | {LABELS[v]} | {r['n']} | {_f(r['grasped'])} | "
+                         f"{_f(r['lifted'])} | {_f(r['placed'])} | "
+                         + ", ".join(f"{k} {n}" for k, n in r["failures"].items())
+                         + f" | {_f(r['wall_seconds_median'])} |")
+        for d, by_variant in t["outcomes"].items():
+            if d not in OURS or "pipeline" not in by_variant:
+                continue
+            statuses = ("placed", "lifted", "grasped", "failed", "error")
+            L += ["", f"{name(d)}, Pipeline, outcomes per category:", "",
+                  "| category | runs | " + " | ".join(statuses) + " |",
+                  "|---|---|" + "---|" * len(statuses)]
+            for c, row in by_variant["pipeline"]["per_category"].items():
+                L.append(f"| {c} | {row['n']} | " + " | ".join(str(row.get(k, 0))
+                                                             for k in statuses) + " |")
+
     a = t["ablations"]
+    if not a["top_category"]:
+        return _text(L)
     L += ["", "## Ablation: the top category only versus the full prior (PLM)", "",
           "| dataset | category full | top only | task E0 full | top only | pre-grasp E0 full | "
           "top only |", "|---|---|---|---|---|---|---|"]
     for d, r in a["top_category"].items():
         f, o = r["full_prior"], r["top_category"]
-        pt = P["top_category"]
         L.append(f"| {name(d)} | {_f(f['category'])} | {_f(o['category'])} | {_f(f['task_E0'])} | "
-                 f"{_both(o['task_E0'], pt['task'].get(d))} | {_f(f['pregrasp_E0'])} | "
-                 f"{_both(o['pregrasp_E0'], pt['pregrasp'].get(d))} |")
+                 f"{_both(o['task_E0'], P['top_category_task'].get(d))} | "
+                 f"{_f(f['pregrasp_E0'])} | "
+                 f"{_both(o['pregrasp_E0'], P['top_category_pregrasp'].get(d))} |")
     L += ["", "## Ablation: mutually exclusive versus not (PLM)", "",
           "| dataset | category excl. | not | task E0 excl. | not | pre-grasp E0 excl. | not |",
           "|---|---|---|---|---|---|---|"]
@@ -503,8 +582,9 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
           f"{_both(md['category'], pm['category'])}, task {_both(md['task_E0'], pm['task'])}, "
           f"pre-grasp {_both(md['pregrasp_E0'], pm['pregrasp'])} points."]
     if a.get("interior"):
-        L += ["## Ablation: the interior observation (ours) versus the paper's observations (PLM)",
-              "", "`interior_seen`: the camera saw the object's inside through a wide opening "
+        L += ["", "## Ablation: the interior observation (ours) versus the paper's observations "
+              "(PLM)", "", "`interior_seen`: the camera saw the object's inside through a wide "
+              "opening "
               "(tg_drake/perception/pose.py `interior_seen`; perfect on S_SYN: an open container "
               "not upside down); the theory rules out cans and bottles "
               "(rules/category_*.pl). The paper has no such observation.", "",
@@ -516,4 +596,4 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
                      f"{_f(w['task_E0'])} | {_f(o['task_E0'])} | {_f(w['pregrasp_E0'])} | "
                      f"{_f(o['pregrasp_E0'])} |")
         L.append("")
-    return "\n".join(L)
+    return _text(L)

@@ -1,8 +1,8 @@
 """Speed figures of the perception stage for `tg-drake bench`.
 
-- ``perception_ms``: completion + pose + parts (with normals, part boxes and pre-grasps) of one
-  object, median over the objects of a synthetic scene; against the paper's published 27.5 ms
-  (completion) + 15.71 ms (pose) on one core of a 2.67 GHz Xeon (not re-run here).
+- ``object_times_ms``: completion + pose + parts (with normals, part boxes and pre-grasps) of each
+  object of a synthetic scene (`tg_drake.evaluation.bench.perception_ms` is the figure: their
+  median beside the paper's published times).
 - ``segmentation_ms``: table plane and object clusters of a full 640×480 depth frame.
 
 The scene is ray cast with Open3D (`tg_drake.perception.synthetic`): a can, a mug, a bottle, a
@@ -21,9 +21,6 @@ from tg_drake.perception.config import PerceptionConfig
 from tg_drake.perception.geometry import Intrinsics, inverse, make_transform, transform
 from tg_drake.perception.pipeline import describe_object
 from tg_drake.perception.segmentation import segment_depth
-
-PAPER_COMPLETION_MS = 27.5  # paper, section VI-C-1: shape completion per object
-PAPER_POSE_MS = 15.71  # paper: pose detection per object
 
 
 def _rz(yaw: float) -> np.ndarray:
@@ -44,20 +41,14 @@ def _scene():
     return S.render_depth(meshes, K, X_WC), K, X_WC
 
 
-def perception_ms() -> Figure:
-    """Median time to describe one object (completion + pose + parts) [ms]."""
+def object_times_ms() -> list[float]:
+    """Median time to describe each object of the scene (completion + pose + parts) [ms]."""
     depth, K, X_WC = _scene()
     cfg = PerceptionConfig()
     seg = segment_depth(depth, K, X_WC, cfg.segmentation)
     p_TC = transform(inverse(seg.X_WT), X_WC[:3, 3][None])[0]
-    times = [median_time(lambda q=q: describe_object(q, seg.X_WT, p_TC, cfg), repeats=15)
-             for q in seg.objects_T]
-    reference = PAPER_COMPLETION_MS + PAPER_POSE_MS
-    return figure(1e3 * float(np.median(times)), "ms",
-                  f"paper: {PAPER_COMPLETION_MS} ms completion + {PAPER_POSE_MS} ms pose per "
-                  f"object on one core of a 2.67 GHz Xeon (published figure, not re-run); ours: "
-                  f"median over {len(times)} objects of a ray-cast scene",
-                  reference)
+    return [1e3 * median_time(lambda q=q: describe_object(q, seg.X_WT, p_TC, cfg), repeats=15)
+            for q in seg.objects_T]
 
 
 def segmentation_ms() -> Figure:
