@@ -26,7 +26,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
-from pydrake.systems.primitives import ConstantValueSource
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.objects import box_centre
@@ -83,7 +82,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     from tg_drake.systems.dgi_system import DgiScoringSystem
     from tg_drake.systems.grasp_planner import GraspPlanner
     from tg_drake.systems.kernel_prior_system import KernelPriorSystem
-    from tg_drake.systems.logic_system import LogicQuerySystem
+    from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
 
     config = config or scenario.pipeline
     config.validate()
@@ -126,8 +125,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     logic = builder.AddNamedSystem("logic", LogicQuerySystem(LogicQueryConfig(
         category=config.category_theory, grasp=config.grasp_theory,
         use_prior=config.use_prior, prior_floor=config.prior_floor)))
-    task = builder.AddNamedSystem("task", ConstantValueSource(
-        AbstractValue.Make(scenario.task.task)))
+    task = builder.AddNamedSystem("task", TaskSource(scenario.task.task))
     builder.Connect(scene, logic.GetInputPort("scene_description"))
     builder.Connect(prior.GetOutputPort("category_prior"), logic.GetInputPort("category_prior"))
     builder.Connect(task.get_output_port(), logic.GetInputPort("task"))

@@ -6,7 +6,7 @@ synthetic (perfect-perception) evaluation.
 
 Both latch their result: the scene description is declared abstract state, written by events
 only — an initialization event (perceive at the start) and, when the ``perception_request``
-input holds a value other than the one last served, a per-step event that perceives again. The
+input holds a value other than the one last served, a periodic event that perceives again. The
 outputs depend on that state alone, so the arm moving into the camera's view changes nothing
 downstream, and every later stage's cache stays valid until perception runs again.
 """
@@ -28,6 +28,15 @@ from tg_drake.perception.geometry import Intrinsics
 from tg_drake.perception.ground_truth import describe_library_object
 from tg_drake.perception.pipeline import describe_scene
 from tg_drake.types import PerceptionStatus, SceneDescription
+
+
+# How often a new perception_request is looked for [s], and the time of the first look [s]. The
+# offset keeps the looks off the plant's step grid (time steps of 0.1, 0.5, 1, 2, 5, 10 ms): Drake
+# rewrites the state of every system with an update event in a step where any update does
+# something, and the plant's does at each of its steps, so a look on the grid would invalidate
+# the latched state, and every downstream cache, at every look.
+REQUEST_PERIOD = 0.05
+REQUEST_OFFSET = 0.01234
 
 
 def _empty_scene() -> SceneDescription:
@@ -57,10 +66,12 @@ class _LatchedPerception(LeafSystem):
             "perception_request", AbstractValue.Make(0))
         self._latch = self.DeclareAbstractState(AbstractValue.Make(_Latch()))
         self.DeclareInitializationUnrestrictedUpdateEvent(self._on_initialization)
-        # Per step rather than periodic: a request is served at the next step, with no period
-        # to choose; a step without a new request returns DidNothing and leaves the state, and
-        # so every downstream cache, untouched.
-        self.DeclarePerStepUnrestrictedUpdateEvent(self._on_step)
+        # Periodic rather than per step: a per-step look shares every step with the plant's
+        # update, which rewrites this state; a periodic one off the plant's grid that finds no
+        # new request returns DidNothing and leaves the state, and every downstream cache, as
+        # they are. A request waits at most REQUEST_PERIOD.
+        self.DeclarePeriodicUnrestrictedUpdateEvent(REQUEST_PERIOD, REQUEST_OFFSET,
+                                                    self._on_look)
         on_latch = {self.abstract_state_ticket(self._latch)}
         self._scene_port = self.DeclareAbstractOutputPort(
             "scene_description", lambda: AbstractValue.Make(_empty_scene()), self._calc_scene,
@@ -95,7 +106,7 @@ class _LatchedPerception(LeafSystem):
         self._latch_perception(context, state, self._request(context))
         return EventStatus.Succeeded()
 
-    def _on_step(self, context, state):
+    def _on_look(self, context, state):
         if not self._request_port.HasValue(context):
             return EventStatus.DidNothing()
         request = self._request(context)
@@ -155,7 +166,8 @@ class PerceptionSystem(_LatchedPerception):
     given by `camera_info`; ``camera_pose`` is the RigidTransform X_WC of the depth camera
     (Drake's camera frame: X right, Y down, Z forward). ``perception_request`` (int) is a
     counter: when it holds a value other than the one last served, the system perceives again at
-    the next simulator step; unconnected, it perceives at initialization only.
+    its next look (every REQUEST_PERIOD = 0.05 s); unconnected, it perceives at initialization
+    only.
 
     Perception runs in events and its result is latched: at initialization, and on a request.
     ``scene_description`` is the latched `SceneDescription`, one `ObjectDescription` per object
