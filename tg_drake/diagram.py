@@ -12,6 +12,7 @@ call `add_station` alone and wire only the stages you want.
 Wiring (DESIGN.md, "The diagram"):
 
     station camera depth, camera pose ─▶ perception ─▶ target ─▶ scene_description
+        (latched: perceived at initialization and on a new perception_request, never live)
     scene_description ─▶ prior ─▶ category_prior
     scene_description, category_prior, task, collisions ─▶ logic ─▶ grasp_semantics
     scene_description, grasp_semantics ─▶ scoring ─▶ ranked_grasps

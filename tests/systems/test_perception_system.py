@@ -107,11 +107,12 @@ def test_the_scene_is_latched_until_a_request(two_objects, cup_alone):
     assert simulator.get_num_steps_taken() > 0
     assert scene_port.Eval(context) is before
     assert status_port.Eval(context).n_perceptions == 1
+    assert not scene_port.cache_entry().is_out_of_date(context)  # a look that found no request
     # A connected request with the value already served changes nothing either.
     system.get_perception_request_input_port().FixValue(context, 0)
     simulator.AdvanceTo(0.2)
     assert scene_port.Eval(context) is before
-    # A new request value: perceived again at the next step, and served once.
+    # A new request value: perceived again at the next look, and served once.
     system.get_perception_request_input_port().FixValue(context, 1)
     simulator.AdvanceTo(0.3)
     after = scene_port.Eval(context)
