@@ -12,6 +12,7 @@ call `add_station` alone and wire only the stages you want.
 Wiring (DESIGN.md, "The diagram"):
 
     station camera depth, camera pose ─▶ perception ─▶ target ─▶ scene_description
+        (latched: perceived at initialization and on a new perception_request, never live)
     scene_description ─▶ prior ─▶ category_prior
     scene_description, category_prior, task, collisions ─▶ logic ─▶ grasp_semantics
     scene_description, grasp_semantics ─▶ scoring ─▶ ranked_grasps
@@ -26,7 +27,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
-from pydrake.systems.primitives import ConstantValueSource
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.objects import box_centre
@@ -82,7 +82,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     from tg_drake.systems.dgi_system import DgiScoringSystem
     from tg_drake.systems.grasp_planner import GraspPlanner
     from tg_drake.systems.kernel_prior_system import KernelPriorSystem
-    from tg_drake.systems.logic_system import LogicQuerySystem
+    from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
 
     config = config or scenario.pipeline
     config.validate()
@@ -124,8 +124,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     prior = builder.AddNamedSystem("kernel_prior", KernelPriorSystem(config.prior_config()))
     builder.Connect(scene, prior.GetInputPort("scene_description"))
     logic = builder.AddNamedSystem("logic", LogicQuerySystem(config.logic))
-    task = builder.AddNamedSystem("task", ConstantValueSource(
-        AbstractValue.Make(scenario.task.task)))
+    task = builder.AddNamedSystem("task", TaskSource(scenario.task.task))
     builder.Connect(scene, logic.GetInputPort("scene_description"))
     builder.Connect(prior.GetOutputPort("category_prior"), logic.GetInputPort("category_prior"))
     builder.Connect(task.get_output_port(), logic.GetInputPort("task"))

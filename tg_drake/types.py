@@ -3,6 +3,7 @@
 These are the values carried on the diagram's abstract-valued ports:
 
 - `SceneDescription` (``scene_description``): one `ObjectDescription` per perceived object.
+- `PerceptionStatus` (``perception_status``): whether the latest perception succeeded, and when.
 - `CategoryPrior` (``category_prior``): one `CategoryDistribution` per object.
 - `GraspSemantics` (``grasp_semantics``): the logic's category, task and part distributions for
   the target object, with explanations.
@@ -101,6 +102,23 @@ class SceneDescription:
     objects: list[ObjectDescription]
     X_WT: np.ndarray  # 4×4 table frame: origin on the table top, z along its normal.
     target: int | None = None  # index into `objects` of the task's target, when known.
+
+    @property
+    def reasoning_target(self) -> int:
+        """The object the logic and the scoring reason about: `target`, else object 0."""
+        return 0 if self.target is None else int(self.target)
+
+
+@dataclass(frozen=True)
+class PerceptionStatus:
+    """Port value of ``perception_status``: how the latest perception went, without raising."""
+
+    ok: bool  # the latched scene description is valid (False before the first perception)
+    error: str = ""  # the PerceptionError's message when the latest perception failed, else ""
+    wall_time: float = 0.0  # [s] wall-clock time the latest perception took
+    n_perceptions: int = 0  # how many perceptions have run in this context
+    request: int = 0  # the perception_request value the latest perception served
+    t_perceived: float | None = None  # [s] simulated time of the latest perception
 
 
 @dataclass

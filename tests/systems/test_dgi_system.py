@@ -176,3 +176,38 @@ def test_local_only_ranks_by_local_shape_alone_and_names_bad_selections(model):
     np.testing.assert_allclose(ranked.p_part, [0.0, 1.0])  # kept for the record
     with pytest.raises(GraspingError, match="unknown grasp selection 'logic'; allowed: pipeline"):
         DgiScoringSystem(model, selection="logic")
+
+
+def test_new_semantics_rerank_without_rescoring_the_shapes(model):
+    # P(grasp | local shape) depends on the scene alone: a cache entry on scene_description.
+    calls = []
+
+    class CountingModel:
+        def p_grasp(self, p_W, X_WG):
+            calls.append(len(X_WG))
+            return model.p_grasp(p_W, X_WG)
+
+    builder = DiagramBuilder()
+    system = builder.AddSystem(DgiScoringSystem(CountingModel()))
+    diagram = builder.Build()
+    context = system.GetMyMutableContextFromRoot(diagram.CreateDefaultContext())
+    poses = np.stack([top_down([0.5, 0, 0.09]), top_down([0.5, 0, 0.07])])
+    parts = [part_index("top"), part_index("middle")]
+    scene = SceneDescription(objects=[cylinder_object(poses, parts)], X_WT=np.eye(4), target=0)
+    system.get_scene_description_input_port().FixValue(context, scene)
+    port = system.get_ranked_grasps_output_port()
+    rankings = []
+    for part in ({"top": 0.9, "middle": 0.1}, {"top": 0.1, "middle": 0.9}):
+        system.get_grasp_semantics_input_port().FixValue(context, GraspSemantics(
+            category={"cup": 1.0}, task={"pass": 1.0}, part=part, given_task="pass"))
+        rankings.append(port.Eval(context))
+    assert calls == [2]
+    p_local = model.p_grasp(scene.objects[0].p_W, poses)
+    for ranked, first in zip(rankings, ("top", "middle")):
+        assert ranked.parts[0] == part_index(first)
+        np.testing.assert_allclose(np.sort(ranked.p_local), np.sort(p_local), atol=1e-12)
+    # A new scene scores its shapes again.
+    system.get_scene_description_input_port().FixValue(
+        context, SceneDescription(objects=[cylinder_object(poses[:1], parts[:1])],
+                                  X_WT=np.eye(4), target=0))
+    assert len(port.Eval(context).score) == 1 and calls == [2, 1]

@@ -7,7 +7,7 @@ import pytest
 
 from tg_drake.errors import RuleError
 from tg_drake.logic.engine import LogicQueryConfig
-from tg_drake.systems.logic_system import LogicQuerySystem
+from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
 from tg_drake.types import (
     CATEGORIES,
     CategoryDistribution,
@@ -114,3 +114,16 @@ def test_bad_inputs_raise_rule_error(system):
         context, SceneDescription(objects=[], X_WT=np.eye(4)))
     with pytest.raises(RuleError, match="no object"):
         system.get_grasp_semantics_output_port().Eval(context)
+
+
+def test_the_task_source_depends_on_nothing():
+    # Its value stays cached as time passes, so the logic downstream is not asked again.
+    source = TaskSource("pass")
+    context = source.CreateDefaultContext()
+    port = source.GetOutputPort("task")
+    assert port.Eval(context) == "pass"
+    context.SetTime(1.0)
+    assert not port.cache_entry().is_out_of_date(context)
+    assert port.Eval(context) == "pass"
+    infer = TaskSource("")
+    assert infer.get_output_port().Eval(infer.CreateDefaultContext()) == ""

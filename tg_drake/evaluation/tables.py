@@ -505,8 +505,8 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
         L += ["## Pipeline versus local shape only (paper Table \"pipeline\")", "",
               "Share of successful grasps (object held through the lift) whose P(grasp | local "
               "shape) is below the threshold, on the scenarios every variant ran. Local ranks all "
-              "hypotheses by P(grasp | local shape) alone (`PipelineConfig.grasp_selection: "
-              "local_only`).", ""]
+              "hypotheses by P(grasp | local shape) alone (`pipeline.scoring: "
+              "!LocalOnly {}`).", ""]
     for d, r in t["pipeline_vs_local"].items():
         vs = [v for v in ("local", "pipeline", "pipeline_uniform") if v in r]
         p = P["pipeline_vs_local"].get(d, {})

@@ -25,18 +25,53 @@ def check_selection(selection: str, part: str | None = None) -> None:
 
 
 def rank_grasps(scene: SceneDescription, semantics: GraspSemantics,
-                model: DgiGraspModel, *, selection: str = "pipeline",
-                part: str | None = None) -> GraspCandidates:
+                model: DgiGraspModel | None, *, selection: str = "pipeline",
+                part: str | None = None, p_local: np.ndarray | None = None) -> GraspCandidates:
     """Every pre-grasp hypothesis of the target object, scored and sorted best first.
 
-    p_local = P(grasp | local shape) from the DGI model, p_part = the logic's P(part | task) of the
-    hypothesis' part (0 for a part the logic did not name), score = p_part · p_local
-    (`selection="pipeline"`) or p_local alone (`"local_only"`), or p_local for the hypotheses of
-    `part` and 0 for the others (`"one_part"`: a part the logic gives 0 is still ranked). Ties
-    keep the hypotheses' order.
+    p_local = P(grasp | local shape) from the DGI model (`local_probabilities`; pass `p_local`
+    when it is known already for the target, and `model` may be None), p_part = the logic's
+    P(part | task) of the hypothesis' part (0 for a part the logic did not name), score =
+    p_part · p_local (`selection="pipeline"`) or p_local alone (`"local_only"`), or p_local for
+    the hypotheses of `part` and 0 for the others (`"one_part"`: a part the logic gives 0 is
+    still ranked). Ties keep the hypotheses' order.
     """
     check_selection(selection, part)
     target = semantics.target
+    X_WG, parts = _hypotheses(scene, target)
+    if len(X_WG) == 0:
+        empty = np.zeros(0)
+        return GraspCandidates(np.zeros((0, 4, 4)), parts, empty, empty, empty, target)
+    if p_local is None:
+        p_local = model.p_grasp(scene.objects[target].p_W, X_WG)
+    p_local = np.asarray(p_local, dtype=float)
+    if p_local.shape != (len(X_WG),):
+        raise GraspingError(f"p_local has shape {p_local.shape} for {len(X_WG)} pre-grasp poses "
+                            f"of object {target}")
+    p_part = np.array([semantics.part.get(PART_LABELS[k], 0.0) for k in parts], dtype=float)
+    if selection == "pipeline":
+        score = p_part * p_local
+    elif selection == "local_only":
+        score = p_local
+    else:
+        score = np.where(parts == PART_LABELS.index(part), p_local, 0.0)
+    order = np.argsort(-score, kind="stable")
+    return GraspCandidates(X_WG[order], parts[order], p_part[order], p_local[order], score[order],
+                           target)
+
+
+def local_probabilities(scene: SceneDescription, target: int,
+                        model: DgiGraspModel) -> np.ndarray:
+    """P(grasp | local shape) of each pre-grasp hypothesis of object `target`, in the order of
+    its `pregrasp_X_WG` (the part of a ranking that depends on the scene alone)."""
+    X_WG, _ = _hypotheses(scene, target)
+    if len(X_WG) == 0:
+        return np.zeros(0)
+    return model.p_grasp(scene.objects[target].p_W, X_WG)
+
+
+def _hypotheses(scene: SceneDescription, target: int) -> tuple[np.ndarray, np.ndarray]:
+    """The pre-grasp poses (M, 4, 4) and part labels (M,) of object `target`, checked."""
     if not 0 <= target < len(scene.objects):
         raise GraspingError(
             f"grasp_semantics names target object {target} but the scene description has "
@@ -51,17 +86,4 @@ def rank_grasps(scene: SceneDescription, semantics: GraspSemantics,
         raise GraspingError(
             f"pre-grasp part labels must index PART_LABELS (0..{len(PART_LABELS) - 1}), got "
             f"{sorted(set(parts.tolist()))}")
-    if len(X_WG) == 0:
-        empty = np.zeros(0)
-        return GraspCandidates(np.zeros((0, 4, 4)), parts, empty, empty, empty, target)
-    p_local = model.p_grasp(obj.p_W, X_WG)
-    p_part = np.array([semantics.part.get(PART_LABELS[k], 0.0) for k in parts], dtype=float)
-    if selection == "pipeline":
-        score = p_part * p_local
-    elif selection == "local_only":
-        score = p_local
-    else:
-        score = np.where(parts == PART_LABELS.index(part), p_local, 0.0)
-    order = np.argsort(-score, kind="stable")
-    return GraspCandidates(X_WG[order], parts[order], p_part[order], p_local[order], score[order],
-                           target)
+    return X_WG, parts

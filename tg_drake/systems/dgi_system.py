@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import LeafSystem
+from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from tg_drake.grasping.model import DgiGraspModel, load_default_model
-from tg_drake.grasping.scoring import check_selection, rank_grasps
+from tg_drake.grasping.scoring import check_selection, local_probabilities, rank_grasps
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 
@@ -22,11 +22,16 @@ class DgiScoringSystem(LeafSystem):
         output_ports:
         - ranked_grasps
 
-    Scores the target object's pre-grasp hypotheses by part and local shape. For the object that ``grasp_semantics`` (a `GraspSemantics`) is about, every pre-grasp
-    hypothesis of ``scene_description`` (a `SceneDescription`) gets P(grasp | local shape) from
-    the DGI features of the object's cloud in the WSG's closing volume and the RBF SVM + Platt
-    sigmoid, and the logic's P(part | task) of its part. ``ranked_grasps`` (a `GraspCandidates`)
-    holds them all with score = P(part | task) · P(grasp | local shape), best first.
+    Scores the target object's pre-grasp hypotheses by part and local shape. For the object that
+    ``grasp_semantics`` (a `GraspSemantics`) is about, every pre-grasp hypothesis of
+    ``scene_description`` (a `SceneDescription`) gets P(grasp | local shape) from the DGI
+    features of the object's cloud in the WSG's closing volume and the RBF SVM + Platt sigmoid,
+    and the logic's P(part | task) of its part. ``ranked_grasps`` (a `GraspCandidates`) holds
+    them all with score = P(part | task) · P(grasp | local shape), best first.
+
+    P(grasp | local shape) depends on the scene alone: it is a cache entry on
+    ``scene_description`` (for the object the logic reasons about, the scene's ``target``),
+    so new semantics (a re-query with collision evidence) re-rank without re-scoring shapes.
 
     The model is the one shipped with the package unless `model` is given. `selection`
     "local_only" ranks by P(grasp | local shape) alone (the paper's Local baseline); "one_part"
@@ -46,14 +51,21 @@ class DgiScoringSystem(LeafSystem):
         self._semantics_port = self.DeclareAbstractInputPort(
             "grasp_semantics",
             AbstractValue.Make(GraspSemantics(category={}, task={}, part={}, given_task=None)))
+        on_scene = {self.input_port_ticket(self._scene_port.get_index())}
+        # (target, its hypotheses' P(grasp | local shape)), or None for a target not in the scene.
+        self._p_local = self.DeclareCacheEntry(
+            "p_local", ValueProducer(allocate=AbstractValue.Make(None).Clone,
+                                     calc=self._calc_p_local),
+            prerequisites_of_calc=on_scene)
         empty = np.zeros(0)
         self._ranked_port = self.DeclareAbstractOutputPort(
             "ranked_grasps",
             lambda: AbstractValue.Make(GraspCandidates(np.zeros((0, 4, 4)), np.zeros(0, int),
                                                        empty, empty, empty)),
             self._calc_ranked_grasps,
-            prerequisites_of_calc={self.input_port_ticket(self._scene_port.get_index()),
-                                   self.input_port_ticket(self._semantics_port.get_index())})
+            prerequisites_of_calc=on_scene | {
+                self._p_local.ticket(),
+                self.input_port_ticket(self._semantics_port.get_index())})
 
     @property
     def model(self) -> DgiGraspModel:
@@ -68,7 +80,21 @@ class DgiScoringSystem(LeafSystem):
     def get_ranked_grasps_output_port(self):
         return self._ranked_port
 
+    def p_local_cache_entry(self):
+        """The cache entry of P(grasp | local shape): (target, one value per hypothesis in the
+        order of its pregrasp_X_WG), or None when the scene's target is not one of its objects."""
+        return self._p_local
+
+    def _calc_p_local(self, context, value):
+        scene: SceneDescription = self._scene_port.Eval(context)
+        target = scene.reasoning_target
+        value.set_value(None if not 0 <= target < len(scene.objects) else
+                        (target, local_probabilities(scene, target, self._model)))
+
     def _calc_ranked_grasps(self, context, output):
-        output.set_value(rank_grasps(self._scene_port.Eval(context),
-                                     self._semantics_port.Eval(context), self._model,
-                                     selection=self._selection, part=self._part))
+        semantics: GraspSemantics = self._semantics_port.Eval(context)
+        cached = self._p_local.Eval(context)
+        p_local = cached[1] if cached is not None and cached[0] == semantics.target else None
+        output.set_value(rank_grasps(self._scene_port.Eval(context), semantics, self._model,
+                                     selection=self._selection, part=self._part,
+                                     p_local=p_local))

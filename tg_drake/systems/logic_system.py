@@ -85,7 +85,7 @@ class LogicQuerySystem(LeafSystem):
         if not scene.objects:
             raise RuleError("the scene description holds no object to reason about",
                             field="scene_description")
-        target = 0 if scene.target is None else int(scene.target)
+        target = scene.reasoning_target
         if not 0 <= target < len(scene.objects):
             raise RuleError(f"target {target} is not an object of the scene description "
                             f"(it has {len(scene.objects)})", field="scene_description.target")
@@ -108,3 +108,27 @@ class LogicQuerySystem(LeafSystem):
                                        prior_floor=self._config.prior_floor)
         answer = self._engine.query(obs, explain=self._config.explain)
         output.set_value(answer.to_semantics(target=target))
+
+
+class TaskSource(LeafSystem):
+    """The task, constant, for the logic's ``task`` input.
+
+    .. pydrake_system::
+
+        name: TaskSource
+        output_ports:
+        - task
+
+    ``task`` (str): a TASKS name, or "" to infer the task. Its output depends on nothing (a
+    ConstantValueSource's depends on every source, the time included), so the logic's cache
+    stays valid while the simulation runs.
+    """
+
+    def __init__(self, task: str):
+        super().__init__()
+        self._task = str(task)
+        self.DeclareAbstractOutputPort("task", lambda: AbstractValue.Make(""), self._calc_task,
+                                       prerequisites_of_calc={self.nothing_ticket()})
+
+    def _calc_task(self, context, output):
+        output.set_value(self._task)
