@@ -23,46 +23,34 @@ Station ports (as exported by `make_station`; `add_station` returns the same por
 
 from __future__ import annotations
 
-import functools
-import importlib.resources
 from dataclasses import dataclass, field
 
 import numpy as np
-from pydrake.geometry import MakeRenderEngineVtk, RenderEngineVtkParams, SceneGraph
+from pydrake.common.value import AbstractValue
+from pydrake.geometry import (ColorRenderCamera, DepthRenderCamera, MakeRenderEngineVtk,
+                              RenderCameraCore, RenderEngineVtkParams, SceneGraph)
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import (AddModel, ModelDirective, ModelDirectives, Parser,
                                        ProcessModelDirectives)
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.multibody.tree import (JointActuatorIndex, ModelInstanceIndex, PdControllerGains, SpatialInertia,
                                     UnitInertia)
+from pydrake.systems.controllers import InverseDynamicsController
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import MatrixGain
 from pydrake.systems.sensors import CameraInfo, RgbdSensor
 
 from tg_drake.errors import ModelError, ScenarioError
+from tg_drake.models import make_parser
+from tg_drake.objects import get_object
 from tg_drake.scenario import (InverseDynamicsDriver, JointPdDriver, ObjectPlacement, Scenario,
                                WsgPdDriver)
 
 WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container
 
 
-@functools.cache
-def models_root() -> str:
-    """The folder of the tg_drake_models package (models/ in the source tree)."""
-    return str(importlib.resources.files("tg_drake_models"))
-
-
-def make_parser(plant: MultibodyPlant) -> Parser:
-    """A parser that resolves package://tg_drake_models/... (and nothing from the internet)."""
-    parser = Parser(plant)
-    parser.package_map().AddPackageXml(f"{models_root()}/package.xml")
-    return parser
-
-
 def placement_pose(scenario: Scenario, placement: ObjectPlacement) -> RigidTransform:
     """X_WO of a placed object: table frame · (xy, yaw on the table) · the library's resting X_TO."""
-    from tg_drake.objects import get_object
-
     obj = get_object(placement.id)
     X_TO = obj.resting_pose(placement.pose).X_TO
     X_T_yaw = RigidTransform(RollPitchYaw(0, 0, np.deg2rad(placement.yaw)),
@@ -112,7 +100,6 @@ class _CameraPose(LeafSystem):
 
 
 def _rigid_transform_value():
-    from pydrake.common.value import AbstractValue
     return AbstractValue.Make(RigidTransform())
 
 
@@ -135,7 +122,6 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser
                  ) -> dict[str, ModelInstanceIndex]:
     if not scenario.objects:
         return {}
-    from tg_drake.objects import get_object
 
     directives = [ModelDirective(add_model=AddModel(
         name=p.instance_name, file=get_object(p.id).sdf_url)) for p in scenario.objects]
@@ -260,10 +246,7 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
 
 def _add_inverse_dynamics(builder, scenario, plant, iiwa, driver):
     """Drake's explicit inverse-dynamics controller for the arm, the gripper as its payload."""
-    from pydrake.multibody.plant import MultibodyPlant as Plant
-    from pydrake.systems.controllers import InverseDynamicsController
-
-    control_plant = Plant(time_step=0.0)
+    control_plant = MultibodyPlant(time_step=0.0)
     parser = make_parser(control_plant)
     kept = [d for d in scenario.directives
             if (d.add_model and d.add_model.name in ("iiwa", "wsg"))
@@ -289,7 +272,6 @@ def _add_inverse_dynamics(builder, scenario, plant, iiwa, driver):
 
 
 def _with_renderer(color_camera, renderer_name: str):
-    from pydrake.geometry import ColorRenderCamera, RenderCameraCore
     core = color_camera.core()
     return ColorRenderCamera(
         RenderCameraCore(renderer_name, core.intrinsics(), core.clipping(),
@@ -297,7 +279,6 @@ def _with_renderer(color_camera, renderer_name: str):
 
 
 def _with_renderer_depth(depth_camera, renderer_name: str):
-    from pydrake.geometry import DepthRenderCamera, RenderCameraCore
     core = depth_camera.core()
     return DepthRenderCamera(
         RenderCameraCore(renderer_name, core.intrinsics(), core.clipping(),

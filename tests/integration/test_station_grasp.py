@@ -5,7 +5,7 @@ import pytest
 
 from tg_drake.objects import get_object
 from tg_drake.scenario import ObjectPlacement, Scenario
-from tg_drake.scripted import grasp_and_lift
+from tg_drake.simulation.scripted import grasp_and_lift
 from tg_drake.station import make_station
 
 

@@ -1,6 +1,6 @@
 """How repeatable is a physics grasp label? The ceiling of any classifier trained on such labels.
 
-tools/label_noise.py executes recorded grasps again (`tg_drake.grasping.episode`): with the same
+tools/label_noise.py executes recorded grasps again (`tg_drake.simulation.episode`): with the same
 gripper pose, and "nudged" — the pose moved a millimetre and turned a degree (`nudge`), a change
 far below the perception's 4 mm resolution. This module holds the
 pure parts: the stratified sample, the nudge, and the analysis of the repeated labels.

@@ -16,11 +16,12 @@ from pydrake.geometry import Box, Cylinder, CollisionFilterDeclaration, Geometry
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.parsing import ModelDirectives, ProcessModelDirectives
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction
+from pydrake.multibody.plant import CoulombFriction
 from pydrake.multibody.tree import SpatialInertia
+from pydrake.planning import RobotDiagramBuilder
 from pydrake.solvers import SnoptSolver, Solve, SolverOptions
-from pydrake.systems.framework import DiagramBuilder
 
+from tg_drake.models import make_parser
 from tg_drake.scenario import IIWA_HOME, Scenario, default_directives
 
 
@@ -62,11 +63,9 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
         or released: its box is a bounding box, and the fingers close on the object inside it);
         the rest of the arm and gripper still keeps clear of them.
     """
-    from tg_drake.station import make_parser
-
     scenario = scenario or Scenario()
-    builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    builder = RobotDiagramBuilder(time_step=0.0)
+    plant, scene_graph = builder.plant(), builder.scene_graph()
     parser = make_parser(plant)
     # Only the robot, the gripper and the table; loose objects become obstacles if at all.
     kept = {"iiwa", "wsg", "table"}
