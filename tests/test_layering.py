@@ -12,6 +12,11 @@ absolute module name. Two rules:
    top level: a subpackage (tg_drake.perception with everything below it) or a module
    (tg_drake.station). Nor is there a cycle between the modules inside a subpackage.
 
+And one policy: an import inside a function is kept only where start-up time or an optional
+dependency needs it — in the command modules that `tg-drake --help` imports (cli.COMMANDS), or
+of an optional or slow library (OPTIONAL_OR_SLOW); every other import stands at module level, where
+the dependency graph can be read.
+
 Imports by name at run time (`importlib.import_module` in cli.COMMANDS and bench.FIGURES) are not
 statements and are not checked.
 """
@@ -35,12 +40,18 @@ FORBIDDEN_IN_CORES = (
 )
 
 
+# Libraries imported inside functions anywhere: optional extras (ray, grakel) and the slow ones
+# used for one output (matplotlib for pictures, tqdm for a progress bar).
+OPTIONAL_OR_SLOW = ("ray", "grakel", "matplotlib", "tqdm")
+
+
 @dataclass(frozen=True)
 class Import:
     source: str  # the importing module, e.g. "tg_drake.kernels.library"
     target: str  # the imported module, e.g. "tg_drake.perception.render"
     path: Path
     line: int
+    local: bool = False  # inside a function
 
     def __str__(self) -> str:
         return f"{self.path}:{self.line}: {self.source} imports {self.target}"
@@ -66,7 +77,11 @@ def imports_of(root: Path, package: str) -> list[Import]:
     found = []
     for source, path in modules.items():
         is_package = path.name == "__init__.py"
-        for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        tree = ast.parse(path.read_text(), filename=str(path))
+        in_function = {id(n) for f in ast.walk(tree)
+                       if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+                       for n in ast.walk(f) if n is not f}
+        for node in ast.walk(tree):
             if isinstance(node, ast.Import):
                 targets = [alias.name for alias in node.names]
             elif isinstance(node, ast.ImportFrom):
@@ -79,7 +94,8 @@ def imports_of(root: Path, package: str) -> list[Import]:
                                     if f"{base}.{a.name}" in modules]
             else:
                 continue
-            found += [Import(source, t, path, node.lineno) for t in targets]
+            found += [Import(source, t, path, node.lineno, id(node) in in_function)
+                      for t in targets]
     return found
 
 
@@ -94,6 +110,13 @@ def core_violations(imports: list[Import], package: str = "tg_drake") -> list[Im
     return [i for i in imports
             if any(_within(i.source, c) for c in cores)
             and any(_within(i.target, f) for f in forbidden)]
+
+
+def misplaced_local_imports(imports: list[Import], command_modules) -> list[Import]:
+    """Imports inside functions that neither a command module's start-up nor an optional or slow
+    library explains."""
+    return [i for i in imports if i.local and i.source not in command_modules
+            and i.target.split(".")[0] not in OPTIONAL_OR_SLOW]
 
 
 def unit_of(module: str, package: str, depth: int) -> str | None:
@@ -208,6 +231,27 @@ def test_the_walk_sees_every_module_and_imports_inside_functions():
     assert any(i.source == "tg_drake.kernels.library" and i.target == "tg_drake.perception.render"
                for i in imports)
     assert any(i.source == "tg_drake.cli" and i.target == "os" for i in imports)
+
+
+def test_imports_inside_functions_only_for_start_up_or_an_optional_library():
+    from tg_drake.cli import COMMANDS
+
+    misplaced = misplaced_local_imports(imports_of(ROOT, "tg_drake"), set(COMMANDS.values()))
+    assert not misplaced, "imports to move to module level:\n" + "\n".join(map(str, misplaced))
+
+
+def test_the_policy_on_imports_inside_functions_can_fail(tmp_path):
+    root = tmp_path / "pkg"
+    _write(root, {
+        "__init__.py": "",
+        "cli.py": "def main():\n    import pydrake.all\n",  # a command module: start-up
+        "plots.py": "import numpy\n\ndef draw():\n    import matplotlib.pyplot\n",
+        "station.py": "class Station:\n    def add(self):\n        from pkg.objects import get\n",
+        "objects.py": "get = lambda: (lambda: __import__('os'))\n",
+    })
+    misplaced = misplaced_local_imports(imports_of(root, "pkg"), {"pkg.cli"})
+    assert [(i.source, i.target, i.line) for i in misplaced] == [
+        ("pkg.station", "pkg.objects", 3)]
 
 
 def _write(root: Path, files: dict[str, str]) -> None:

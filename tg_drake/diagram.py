@@ -29,9 +29,16 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantValueSource
 
 from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.kernels.database import KernelPriorConfig
+from tg_drake.logic.engine import LogicQueryConfig
 from tg_drake.objects import box_centre
 from tg_drake.scenario import PipelineConfig, Scenario
 from tg_drake.station import Station, add_station, placement_pose
+from tg_drake.systems.dgi_system import DgiScoringSystem
+from tg_drake.systems.grasp_planner import GraspPlanner
+from tg_drake.systems.kernel_prior_system import KernelPriorSystem
+from tg_drake.systems.logic_system import LogicQuerySystem
+from tg_drake.systems.perception_system import GroundTruthPerception, PerceptionSystem
 from tg_drake.targeting import select_target
 from tg_drake.types import SceneDescription
 
@@ -78,13 +85,6 @@ class Pipeline:
 def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
                  config: PipelineConfig | None = None) -> Pipeline:
     """Adds the station and every stage of `scenario` to `builder`, wired as in the module doc."""
-    from tg_drake.kernels.database import KernelPriorConfig
-    from tg_drake.logic.engine import LogicQueryConfig
-    from tg_drake.systems.dgi_system import DgiScoringSystem
-    from tg_drake.systems.grasp_planner import GraspPlanner
-    from tg_drake.systems.kernel_prior_system import KernelPriorSystem
-    from tg_drake.systems.logic_system import LogicQuerySystem
-
     config = config or scenario.pipeline
     config.validate()
     station = add_station(builder, scenario=scenario)
@@ -93,8 +93,6 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
 
     # Perception: the rendered depth image of one camera, or the library's ground truth.
     if config.perception == "depth":
-        from tg_drake.systems.perception_system import PerceptionSystem
-
         if config.camera not in station.cameras:
             raise unknown_name("camera", config.camera, list(station.cameras),
                                error=ScenarioError, field="pipeline.camera")
@@ -105,8 +103,6 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
         builder.Connect(station.outputs[f"{config.camera}.camera_pose"],
                         perception.GetInputPort("camera_pose"))
     else:
-        from tg_drake.systems.perception_system import GroundTruthPerception
-
         perception = builder.AddNamedSystem("perception", GroundTruthPerception(
             [p.id for p in scenario.objects],
             [placement_pose(scenario, p) for p in scenario.objects],

@@ -23,13 +23,14 @@ import numpy as np
 import yaml
 from pydrake.common.schema import Transform
 from pydrake.common.yaml import yaml_load_typed
-from pydrake.math import RigidTransform, RollPitchYaw
+from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import AddModel, AddWeld, ModelDirective
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.sensors import CameraConfig
 
 from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.objects import get_object
 from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 # Where the table-top frame T sits in the world (its surface at the iiwa base height). Its centre
@@ -94,7 +95,6 @@ def look_at(p_WC, p_WTarget, up_W=(0.0, 0.0, 1.0)) -> RigidTransform:
         raise ScenarioError("camera looks along the up direction; choose another viewpoint")
     x = x / np.linalg.norm(x)
     y = np.cross(z, x)
-    from pydrake.math import RotationMatrix
     return RigidTransform(RotationMatrix(np.column_stack([x, y, z])), p_WC)
 
 
@@ -299,7 +299,6 @@ def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
         if not placement.id:
             raise ScenarioError("an object needs an `id` (see `tg-drake objects`)", file=where,
                                 field=f + ".id")
-        from tg_drake.objects import get_object  # the library loads only when objects are named
 
         try:
             obj = get_object(placement.id)

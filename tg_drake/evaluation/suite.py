@@ -26,9 +26,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
+from pydrake.common.yaml import yaml_load_typed
 
 from tg_drake.errors import ScenarioError, unknown_name
-from tg_drake.scenario import ObjectPlacement, TaskConfig
+from tg_drake.objects import get_object, load_library
+from tg_drake.scenario import ObjectPlacement, Scenario, TaskConfig, validate
 from tg_drake.types import CATEGORIES, CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 KINDS = ("synthetic", "perceived", "executed")
@@ -153,8 +155,6 @@ class Case:
 
     def meta(self) -> dict:
         """The case as JSON (part of every record it gives)."""
-        from tg_drake.objects import get_object
-
         p = self.target_placement
         return {"suite": self.suite, "kind": self.kind, "dataset": self.dataset,
                 "variant": self.variant, "object": p.id, "pose": p.pose, "yaw": p.yaw,
@@ -167,8 +167,6 @@ class Case:
 
 
 def _load_typed(cls, path: Path):
-    from pydrake.common.yaml import yaml_load_typed
-
     if not path.is_file():
         raise ScenarioError("no such suite file", file=str(path))
     try:
@@ -270,8 +268,6 @@ def _can_hold_water(obj, pose: str) -> bool:
 
 
 def _generated(suite: Suite, gt: GroundTruthTables, where: str, gt_where: str) -> list[Case]:
-    from tg_drake.objects import load_library
-
     g = suite.generator
     library = load_library()
     chosen = []
@@ -334,9 +330,6 @@ def _generated(suite: Suite, gt: GroundTruthTables, where: str, gt_where: str) -
 
 
 def _scenes(suite: Suite, where: str) -> list[Case]:
-    from tg_drake.objects import get_object
-    from tg_drake.scenario import Scenario, validate
-
     cases = []
     for i, scene in enumerate(suite.scenes):
         f = f"scenes[{i}]"
