@@ -226,7 +226,8 @@ def test_tg_drake_keeps_its_layers():
 def test_the_walk_sees_every_module_and_imports_inside_functions():
     imports = imports_of(ROOT, "tg_drake")
     sources = {i.source for i in imports}
-    assert {"tg_drake.cli", "tg_drake.perception.pipeline", "tg_drake.simulation.episode"} <= sources
+    assert {"tg_drake.cli", "tg_drake.perception.pipeline",
+            "tg_drake.simulation.episode"} <= sources
     # A core importing another core, and the CLI's run-time import of os inside main().
     assert any(i.source == "tg_drake.kernels.library" and i.target == "tg_drake.perception.render"
                for i in imports)

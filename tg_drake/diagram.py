@@ -42,6 +42,7 @@ from tg_drake.systems.perception_system import GroundTruthPerception, Perception
 from tg_drake.targeting import select_target
 from tg_drake.types import SceneDescription
 
+
 class TargetSelector(LeafSystem):
     """Marks the task's target among the perceived objects (`tg_drake.targeting.select_target`).
 

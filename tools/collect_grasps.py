@@ -28,8 +28,8 @@ import numpy as np
 
 from tg_drake.executor import EXECUTORS, Job, finished_jobs, make_executor, run_jobs
 from tg_drake.grasping.dataset import SamplingConfig, library_scenes, scene_grasps
-from tg_drake.simulation.episode import EpisodeConfig, run_grasp_batch
 from tg_drake.objects import get_object, load_library
+from tg_drake.simulation.episode import EpisodeConfig, run_grasp_batch
 
 
 def make_jobs(objects, *, seed: int, batch: int, sampling: SamplingConfig,

@@ -34,7 +34,6 @@ import numpy as np
 
 from tg_drake.errors import GraspingError
 from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
-from tg_drake.simulation.episode import EpisodeConfig, run_grasp_batch
 from tg_drake.grasping.repeatability import (
     analyse,
     held,
@@ -43,6 +42,7 @@ from tg_drake.grasping.repeatability import (
     stratum_weights,
 )
 from tg_drake.objects import get_object
+from tg_drake.simulation.episode import EpisodeConfig, run_grasp_batch
 
 
 def category(object_id: str) -> str:

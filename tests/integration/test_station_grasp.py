@@ -1,6 +1,5 @@
 """A scripted grasp in the full station: the WSG closes on an object's body and the arm lifts it."""
 
-import numpy as np
 import pytest
 
 from tg_drake.objects import get_object

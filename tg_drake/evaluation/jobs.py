@@ -32,7 +32,7 @@ from tg_drake.perception.ground_truth import interior_visible
 from tg_drake.perception.render import perceive
 from tg_drake.run import run_scenario
 from tg_drake.scenario import PipelineConfig, Scenario, TaskConfig, validate
-from tg_drake.types import CATEGORIES, TASKS
+from tg_drake.types import CATEGORIES
 
 # Logic methods (the paper's columns, the paper's two ablations and ours): name → (category/task
 # theory, pre-grasp theory, prior[, "no_interior"]). Theories as (category model, grasp model, exclusive); the pre-grasp

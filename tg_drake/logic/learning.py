@@ -77,7 +77,7 @@ from problog.program import SimpleProgram
 from tg_drake.errors import RuleError, unknown_name
 from tg_drake.logic.names import OBJECT, TASK_ATOMS
 from tg_drake.logic.observations import observation_schema
-from tg_drake.logic.theory import SourceClause, TheoryConfig, _load_file, load_theory, rules_dir
+from tg_drake.logic.theory import SourceClause, _load_file, rules_dir
 from tg_drake.types import CATEGORIES, CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 MODELS: tuple[str, ...] = ("grasp", "category")

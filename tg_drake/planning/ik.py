@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import Box, Cylinder, CollisionFilterDeclaration, GeometrySet
+from pydrake.geometry import Box, CollisionFilterDeclaration, Cylinder, GeometrySet
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.parsing import ModelDirectives, ProcessModelDirectives
@@ -23,7 +23,6 @@ from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 
 from tg_drake.models import make_parser
 from tg_drake.scenario import IIWA_HOME, Scenario, default_directives
-
 
 # Weight of the IK's pull towards its seed [1/rad²]: a preference among the solutions that meet
 # the (hard) pose and clearance constraints.
