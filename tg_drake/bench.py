@@ -18,7 +18,7 @@ HELP = "measure the speed figures (JSON of medians and ratios against references
 
 # figure name → "module:function" returning a Figure. Order is the output order.
 FIGURES: dict[str, str] = {
-    "sim_rtf": "tg_drake.scripted:bench_sim_rtf",
+    "sim_rtf": "tg_drake.simulation.scripted:bench_sim_rtf",
     "kernel_query_ms": "tg_drake.kernels.bench:kernel_query_ms",
     "kernel_loo_s": "tg_drake.kernels.bench:kernel_loo_s",
     "logic_scene_ms": "tg_drake.logic.bench:logic_scene_ms",

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 from tg_drake.errors import TgDrakeError
@@ -47,8 +48,6 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:
         # The reader went away (`tg-drake query x.yaml | head`): stop quietly, as Unix tools do,
         # and keep Python from reporting the closed pipe again when it flushes at exit.
-        import os
-
         try:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         except (OSError, ValueError):  # stdout is not a file (a test's capture)

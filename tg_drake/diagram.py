@@ -29,11 +29,18 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.grasping.model import load_model
 from tg_drake.objects import box_centre
 from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario
 from tg_drake.station import Station, add_station, placement_pose
+from tg_drake.systems.dgi_system import DgiScoringSystem
+from tg_drake.systems.grasp_planner import GraspPlanner
+from tg_drake.systems.kernel_prior_system import KernelPriorSystem
+from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
+from tg_drake.systems.perception_system import GroundTruthPerception, PerceptionSystem
 from tg_drake.targeting import select_target
 from tg_drake.types import SceneDescription
+
 
 class TargetSelector(LeafSystem):
     """Marks the task's target among the perceived objects (`tg_drake.targeting.select_target`).
@@ -78,12 +85,6 @@ class Pipeline:
 def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
                  config: PipelineConfig | None = None) -> Pipeline:
     """Adds the station and every stage of `scenario` to `builder`, wired as in the module doc."""
-    from tg_drake.grasping.model import load_model
-    from tg_drake.systems.dgi_system import DgiScoringSystem
-    from tg_drake.systems.grasp_planner import GraspPlanner
-    from tg_drake.systems.kernel_prior_system import KernelPriorSystem
-    from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
-
     config = config or scenario.pipeline
     config.validate()
     station = add_station(builder, scenario=scenario)
@@ -92,8 +93,6 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
 
     # Perception: the rendered depth image of one camera, or the library's ground truth.
     if isinstance(config.perception, DepthPerception):
-        from tg_drake.systems.perception_system import PerceptionSystem
-
         camera = config.perception.camera
         if camera not in station.cameras:
             raise unknown_name("camera", camera, list(station.cameras),
@@ -105,8 +104,6 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
         builder.Connect(station.outputs[f"{camera}.camera_pose"],
                         perception.GetInputPort("camera_pose"))
     else:
-        from tg_drake.systems.perception_system import GroundTruthPerception
-
         perception = builder.AddNamedSystem("perception", GroundTruthPerception(
             [p.id for p in scenario.objects],
             [placement_pose(scenario, p) for p in scenario.objects],

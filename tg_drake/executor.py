@@ -145,7 +145,7 @@ class RayExecutor(Executor):
 
     def __init__(self, address: str | None = None, *, max_in_flight: int | None = None):
         try:
-            import ray
+            import ray  # optional (the `ray` extra)
         except ImportError:
             raise TgDrakeError(
                 "the Ray executor needs Ray, which is not installed: "
@@ -222,7 +222,8 @@ def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, execut
     summary = RunSummary(len(jobs), len(jobs) - len(todo), 0, 0, 0)
     bar = None
     if progress:
-        from tqdm import tqdm
+        from tqdm import tqdm  # start-up: this module is on `tg-drake --help`'s path; tqdm ~0.5 s
+
         bar = tqdm(total=len(todo), desc=out.name, unit="job")
     with out.open("a") as f:
         # A file cut mid-line by a killed run: start on a fresh line.

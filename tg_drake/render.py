@@ -22,7 +22,7 @@ def add_arguments(parser) -> None:
 
 def render_frames(scenario) -> dict[str, dict[str, np.ndarray]]:
     """camera name → {"rgb": (H, W, 3) uint8, "depth": (H, W) float32 [m], "label": (H, W) int}."""
-    from tg_drake.station import make_station
+    from tg_drake.station import make_station  # start-up: --help imports this module; pydrake
 
     diagram, station = make_station(scenario)
     context = diagram.CreateDefaultContext()
@@ -50,7 +50,7 @@ def depth_to_grey(depth: np.ndarray) -> np.ndarray:
 
 def labels_to_rgb(label: np.ndarray) -> np.ndarray:
     """A distinct colour per label value; Drake's reserved labels (empty, unspecified) are black."""
-    import matplotlib
+    import matplotlib  # start-up: --help imports this module
 
     palette = (np.array(matplotlib.colormaps["tab20"].colors) * 255).astype(np.uint8)
     out = palette[np.mod(label, len(palette))]
@@ -59,6 +59,7 @@ def labels_to_rgb(label: np.ndarray) -> np.ndarray:
 
 
 def main(args) -> int:
+    # Start-up: `tg-drake --help` imports this module; matplotlib and pydrake are slow to import.
     import matplotlib.pyplot as plt
 
     from tg_drake.scenario import load_scenario

@@ -9,35 +9,44 @@ scenario says. The plant is not finalised: the caller may add to it first.
 
 from __future__ import annotations
 
-import functools
-import importlib.resources
 
-from pydrake.multibody.parsing import (ModelDirective, ModelDirectives, ModelInstanceInfo, Parser,
-                                       ProcessModelDirectives)
+from pydrake.common.schema import Transform
+from pydrake.math import RigidTransform, RollPitchYaw
+from pydrake.multibody.parsing import (AddModel, AddWeld, ModelDirective, ModelDirectives,
+                                       ModelInstanceInfo, ProcessModelDirectives)
 from pydrake.multibody.plant import MultibodyPlant
 
 from tg_drake.errors import ModelError, ScenarioError
-from tg_drake.scenario import Scenario, default_directives
+from tg_drake.models import make_parser
+from tg_drake.robot import (IIWA_HOME, IIWA_JOINT_NAMES, WSG_FINGER_JOINTS, WSG_OPEN_POSITIONS,
+                            X_7G_RPY, X_7G_XYZ)
 
 
-@functools.cache
-def models_root() -> str:
-    """The folder of the tg_drake_models package (models/ in the source tree)."""
-    return str(importlib.resources.files("tg_drake_models"))
 
-
-def make_parser(plant: MultibodyPlant) -> Parser:
-    """A parser that resolves package://tg_drake_models/... (and nothing from the internet)."""
-    parser = Parser(plant)
-    parser.package_map().AddPackageXml(f"{models_root()}/package.xml")
-    return parser
+def default_directives() -> list[ModelDirective]:
+    """The robot: the iiwa on the floor at the world origin, the WSG on its flange. (The table is
+    not a directive: the station adds it from `table_size` and `X_WT`, tg_drake.table.)"""
+    mount = Transform(RigidTransform(RollPitchYaw(*X_7G_RPY), X_7G_XYZ))
+    return [
+        ModelDirective(add_model=AddModel(
+            name="iiwa", file="package://tg_drake_models/iiwa14/iiwa14.urdf",
+            default_joint_positions={n: [q] for n, q in zip(IIWA_JOINT_NAMES, IIWA_HOME,
+                                                            strict=True)})),
+        ModelDirective(add_weld=AddWeld(parent="world", child="iiwa::iiwa_link_0")),
+        ModelDirective(add_model=AddModel(
+            name="wsg", file="package://tg_drake_models/wsg_50/wsg_50.sdf",
+            default_joint_positions={n: [q] for n, q in zip(WSG_FINGER_JOINTS,
+                                                            WSG_OPEN_POSITIONS, strict=True)})),
+        ModelDirective(add_weld=AddWeld(parent="iiwa::iiwa_link_7", child="wsg::body",
+                                        X_PC=mount)),
+    ]
 
 
 def _model_of(scoped_name: str) -> str:
     return scoped_name.split("::")[0]
 
 
-def model_directives(scenario: Scenario | None,
+def model_directives(scenario,
                      model_instance_names: tuple[str, ...] | list[str]) -> list[ModelDirective]:
     """The directives of `scenario` (default: the station's) that add the named models, and the
     welds whose child is one of their frames. Raises ScenarioError when a named model is not
@@ -55,7 +64,7 @@ def model_directives(scenario: Scenario | None,
             or (d.add_weld and _model_of(d.add_weld.child) in names)]
 
 
-def add_scenario_models(plant: MultibodyPlant, scenario: Scenario | None,
+def add_scenario_models(plant: MultibodyPlant, scenario,
                         model_instance_names: tuple[str, ...] | list[str]
                         ) -> list[ModelInstanceInfo]:
     """Adds to `plant` (not finalised) the named models of `scenario` (default: the station's)

@@ -20,8 +20,15 @@ import numpy as np
 
 from tg_drake.logic.theory import VARIANTS as THEORY_VARIANTS
 from tg_drake import robot
+from tg_drake.bench import Figure
 from tg_drake.errors import (GraspingError, KernelError, PerceptionError, PlanningError,
                              RuleError, SimulationError, TgDrakeError)
+from tg_drake.objects import box_centre
+from tg_drake.outcome import hand_contact, placed, touches_table
+from tg_drake.types import PART_COLORS
+
+# Start-up: `tg-drake --help` imports this module, so pydrake, the diagram, the scenario schema
+# (pydrake) and matplotlib are imported inside the functions that use them.
 
 HELP = "run the whole pipeline on a scenario: perceive, reason, score, plan, grasp, place"
 
@@ -158,9 +165,6 @@ def run_scenario(scenario, *, scenario_path: str = "", meshcat=None, images_dir:
 
 def _execute(simulator, pipeline, scenario, result, timings, visualizer) -> Outcome:
     """Simulates planning and execution; reads off what physically happened."""
-    from tg_drake.objects import box_centre
-    from tg_drake.outcome import hand_contact, placed, touches_table
-
     context = simulator.get_mutable_context()
     station = pipeline.station
     plant = station.plant
@@ -306,8 +310,6 @@ def save_grasp_png(obj, X_WG: np.ndarray, path: Path, *, title: str = "") -> Pat
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from tg_drake.types import PART_COLORS
-
     fig = plt.figure(figsize=(5, 5))
     ax = fig.add_subplot(projection="3d")
     idx = np.random.default_rng(0).permutation(len(obj.p_W))[:5000]
@@ -405,7 +407,6 @@ def bench_pipeline_rtf():
     the one-off diagram build is not counted), median of 3 runs. The reference is the same run with
     Drake's explicit inverse-dynamics arm controller at a 2 ms step (one run); `speedup` = ours /
     reference (a rate: higher is better)."""
-    from tg_drake.bench import Figure
     from tg_drake.scenario import InverseDynamicsDriver, ObjectPlacement, Scenario, TaskConfig
 
     def rate(explicit: bool) -> float:

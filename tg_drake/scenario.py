@@ -21,10 +21,11 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from scipy.spatial import ConvexHull
 from pydrake.common.schema import Transform
 from pydrake.common.yaml import yaml_load_typed
-from pydrake.math import RigidTransform, RollPitchYaw
-from pydrake.multibody.parsing import AddModel, AddWeld, ModelDirective
+from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
+from pydrake.multibody.parsing import ModelDirective
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.sensors import CameraConfig
@@ -33,18 +34,15 @@ from tg_drake.errors import RuleError, ScenarioError, unknown_name
 from tg_drake.kernels.database import SOURCES as KERNEL_SOURCES
 from tg_drake.kernels.database import KernelPriorConfig
 from tg_drake.logic.engine import LogicQueryConfig
+from tg_drake.objects import get_object, mesh
 from tg_drake.perception.config import PerceptionConfig
 from tg_drake.planning.planner import PlannerConfig
-from tg_drake.robot import (IIWA_HOME, IIWA_JOINT_NAMES, WSG_FINGER_JOINTS, WSG_FORCE_LIMIT,
-                            WSG_OPEN_POSITIONS, X_7G_RPY, X_7G_XYZ)
+from tg_drake.robot import IIWA_HOME, WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
+from tg_drake.robot_plants import default_directives
 from tg_drake.schema_check import SchemaError, check_document, load_raw
-from tg_drake.table import TABLE_SIZE, table_size_problem
+from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, table_size_problem
 from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
 
-# Where the table-top frame T sits in the world (its surface at the iiwa base height). Its centre
-# is 0.75 m in front of the base: side grasps at 0.7–0.9 m and top grasps at 0.45–0.8 m are within
-# reach there (an IK sweep over grasp heights 0.04–0.25 m; see tools notes in the README).
-X_WT_DEFAULT = RigidTransform([0.75, 0.0, 0.0])
 
 # The WSG body frame G on the iiwa's link 7 (tg_drake.robot: the mount).
 X_7G = RigidTransform(RollPitchYaw(*X_7G_RPY), X_7G_XYZ)
@@ -55,23 +53,6 @@ def _transform(X: RigidTransform, base_frame: str | None = None) -> Transform:
     if base_frame is not None:
         t.base_frame = base_frame
     return t
-
-
-def default_directives() -> list[ModelDirective]:
-    """The robot: the iiwa on the floor at the world origin, the WSG on its flange. (The table is
-    not a directive: the station adds it from `table_size` and `X_WT`, tg_drake.table.)"""
-    return [
-        ModelDirective(add_model=AddModel(
-            name="iiwa", file="package://tg_drake_models/iiwa14/iiwa14.urdf",
-            default_joint_positions={n: [q] for n, q in zip(IIWA_JOINT_NAMES, IIWA_HOME)})),
-        ModelDirective(add_weld=AddWeld(parent="world", child="iiwa::iiwa_link_0")),
-        ModelDirective(add_model=AddModel(
-            name="wsg", file="package://tg_drake_models/wsg_50/wsg_50.sdf",
-            default_joint_positions={n: [q] for n, q in zip(WSG_FINGER_JOINTS,
-                                                            WSG_OPEN_POSITIONS)})),
-        ModelDirective(add_weld=AddWeld(parent="iiwa::iiwa_link_7", child="wsg::body",
-                                        X_PC=_transform(X_7G))),
-    ]
 
 
 def default_cameras() -> dict[str, CameraConfig]:
@@ -96,7 +77,6 @@ def look_at(p_WC, p_WTarget, up_W=(0.0, 0.0, 1.0)) -> RigidTransform:
         raise ScenarioError("camera looks along the up direction; choose another viewpoint")
     x = x / np.linalg.norm(x)
     y = np.cross(z, x)
-    from pydrake.math import RotationMatrix
     return RigidTransform(RotationMatrix(np.column_stack([x, y, z])), p_WC)
 
 
@@ -417,7 +397,6 @@ def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
         if not placement.id:
             raise ScenarioError("an object needs an `id` (see `tg-drake objects`)", file=where,
                                 field=f + ".id")
-        from tg_drake.objects import get_object  # the library loads only when objects are named
 
         try:
             obj = get_object(placement.id)
@@ -565,7 +544,6 @@ INTERPENETRATION_DEPTH = 0.002
 
 def _footprint_points(scenario: Scenario, placement: ObjectPlacement) -> np.ndarray:
     """(V, 3) the object's mesh vertices in the table frame T, as placed [m]."""
-    from tg_drake.objects import get_object, mesh
 
     obj = get_object(placement.id)
     X_TO = np.asarray(obj.resting_pose(placement.pose).X_TO)
@@ -593,8 +571,6 @@ def _validate_geometry(scenario: Scenario) -> None:
                             f"|y| ≤ {half[1]} in the table frame)", field="task.place_xy")
     if len(scenario.objects) < 2:
         return
-    from scipy.spatial import ConvexHull
-
     points = [_footprint_points(scenario, p) for p in scenario.objects]
     hulls = [ConvexHull(p) for p in points]
     for i in range(len(points)):

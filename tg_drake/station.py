@@ -32,7 +32,7 @@ import importlib.resources
 from dataclasses import dataclass, field
 
 import numpy as np
-from pydrake.geometry import SceneGraph
+from pydrake.geometry import MakeRenderEngineGl, RenderEngineGlParams, SceneGraph, kHasRenderEngineGl
 from pydrake.lcm import DrakeLcm
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import (AddModel, ModelDirective, ModelDirectives, Parser,
@@ -40,13 +40,16 @@ from pydrake.multibody.parsing import (AddModel, ModelDirective, ModelDirectives
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.multibody.tree import (JointActuatorIndex, ModelInstanceIndex, PdControllerGains, SpatialInertia,
                                     UnitInertia)
+from pydrake.systems.controllers import InverseDynamicsController
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import MatrixGain
 from pydrake.systems.sensors import ApplyCameraConfig, CameraConfig, CameraInfo, RgbdSensor
 
 from tg_drake.errors import ModelError, ScenarioError, unknown_name
+from tg_drake.models import make_parser
+from tg_drake.objects import get_object
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
-from tg_drake.robot_plants import add_scenario_models, make_parser
+from tg_drake.robot_plants import add_scenario_models
 from tg_drake.scenario import (InverseDynamicsDriver, JointPdDriver, ObjectPlacement, Scenario,
                                WsgPdDriver)
 from tg_drake.table import add_table
@@ -57,8 +60,6 @@ NO_LCM = "memq://null"  # the LCM URL that publishes nothing: the station sends 
 
 def placement_pose(scenario: Scenario, placement: ObjectPlacement) -> RigidTransform:
     """X_WO of a placed object: table frame · (xy, yaw on the table) · the library's resting X_TO."""
-    from tg_drake.objects import get_object
-
     obj = get_object(placement.id)
     X_TO = obj.resting_pose(placement.pose).X_TO
     X_T_yaw = RigidTransform(RollPitchYaw(0, 0, np.deg2rad(placement.yaw)),
@@ -108,7 +109,6 @@ class _CameraPose(LeafSystem):
 
 
 def _rigid_transform_value():
-    from pydrake.common.value import AbstractValue
     return AbstractValue.Make(RigidTransform())
 
 
@@ -131,7 +131,6 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser
                  ) -> dict[str, ModelInstanceIndex]:
     if not scenario.objects:
         return {}
-    from tg_drake.objects import get_object
 
     directives = [ModelDirective(add_model=AddModel(
         name=p.instance_name, file=get_object(p.id).sdf_url)) for p in scenario.objects]
@@ -247,7 +246,6 @@ RENDERER_CLASSES = ("RenderEngineVtk", "RenderEngineGl")
 @functools.cache
 def _gl_unavailable() -> str | None:
     """Why RenderEngineGl cannot render on this machine (no display, no GL build), or None."""
-    from pydrake.geometry import MakeRenderEngineGl, RenderEngineGlParams, kHasRenderEngineGl
     if not kHasRenderEngineGl:
         return "this Drake build has no RenderEngineGl"
     try:
@@ -312,10 +310,7 @@ def _add_camera(builder: DiagramBuilder, station: Station, name: str, config: Ca
 
 def _add_inverse_dynamics(builder, scenario, plant, iiwa, driver):
     """Drake's explicit inverse-dynamics controller for the arm, the gripper as its payload."""
-    from pydrake.multibody.plant import MultibodyPlant as Plant
-    from pydrake.systems.controllers import InverseDynamicsController
-
-    control_plant = Plant(time_step=0.0)
+    control_plant = MultibodyPlant(time_step=0.0)
     add_scenario_models(control_plant, scenario, ("iiwa", "wsg"))
     wsg = control_plant.GetModelInstanceByName("wsg")
     for joint in WSG_FINGER_JOINTS:

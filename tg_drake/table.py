@@ -18,6 +18,10 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex
 
+# Where the table-top frame T sits in the world (its surface at the iiwa base height). Its centre
+# is 0.75 m in front of the base: side grasps at 0.7–0.9 m and top grasps at 0.45–0.8 m are within
+# reach there (an IK sweep over grasp heights 0.04–0.25 m; see tools notes in the README).
+X_WT_DEFAULT = RigidTransform([0.75, 0.0, 0.0])
 TABLE_SIZE = (0.8, 1.2)  # [m] default top x (depth, away from the robot) × y (width)
 TABLE_THICKNESS = 0.04  # [m] of the top slab
 TABLE_HEIGHT = 0.4  # [m] table-top surface above the floor

@@ -2,7 +2,7 @@
 
 For every library object in every resting pose that suits it, the grasps of
 `tg_drake.grasping.dataset.scene_grasps` (part-box pre-grasps, perturbed copies, random ones) are
-executed by a free-floating WSG 50 in hydroelastic contact (`tg_drake.grasping.episode`): approach,
+executed by a free-floating WSG 50 in hydroelastic contact (`tg_drake.simulation.episode`): approach,
 close, lift, shake; the label is whether the object stays between the fingers. Jobs (batches of
 grasps on one scene) go through the executor interface and their records stream to JSON Lines; a
 rerun skips finished batches. A summary (counts per object and label, throughput) is written next
@@ -28,8 +28,8 @@ import numpy as np
 
 from tg_drake.executor import EXECUTORS, Job, finished_jobs, make_executor, run_jobs
 from tg_drake.grasping.dataset import SamplingConfig, library_scenes, scene_grasps
-from tg_drake.grasping.episode import EpisodeConfig, run_grasp_batch
 from tg_drake.objects import get_object, load_library
+from tg_drake.simulation.episode import EpisodeConfig, run_grasp_batch
 
 
 def make_jobs(objects, *, seed: int, batch: int, sampling: SamplingConfig,

@@ -1,7 +1,7 @@
 """How repeatable are the physics labels of the DGI training set? The ceiling of any classifier.
 
 Re-executes a random sample of the recorded grasps of tools/collect_grasps.py, stratified by
-object category and label, with `tg_drake.grasping.episode` (the same world, object pose and
+object category and label, with `tg_drake.simulation.episode` (the same world, object pose and
 episode script as the collection):
 
 - "exact": the same gripper pose again — does the simulation give the same label twice?
@@ -34,7 +34,6 @@ import numpy as np
 
 from tg_drake.errors import GraspingError
 from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
-from tg_drake.grasping.episode import EpisodeConfig, run_grasp_batch
 from tg_drake.grasping.repeatability import (
     analyse,
     held,
@@ -43,6 +42,7 @@ from tg_drake.grasping.repeatability import (
     stratum_weights,
 )
 from tg_drake.objects import get_object
+from tg_drake.simulation.episode import EpisodeConfig, run_grasp_batch
 
 
 def category(object_id: str) -> str:

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets up tg_drake on a fresh Debian 12 machine: the one system library open3d needs (libusb-1.0),
 # a virtual environment in .venv, and the package with its test extras. Idempotent and quick when
-# nothing changed (a stamp file records the pyproject.toml it installed).
+# nothing changed (a stamp file records the pyproject.toml and setup.py it installed).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -19,10 +19,16 @@ if [ ! -x .venv/bin/python ]; then
   "$PYTHON" -m venv .venv
 fi
 
+# pip and the build backend write to a log, shown only when the installation fails.
 stamp=.venv/.tg_drake_installed
-if [ ! -f "$stamp" ] || ! cmp -s pyproject.toml "$stamp"; then
-  echo "[setup] installing tg_drake and its dependencies into .venv"
-  .venv/bin/python -m pip install -q --upgrade pip
-  .venv/bin/python -m pip install -q -e '.[test]'
-  cp pyproject.toml "$stamp"
+log=.venv/setup.log
+if [ ! -f "$stamp" ] || ! cat pyproject.toml setup.py | cmp -s - "$stamp"; then
+  echo "[setup] installing tg_drake and its dependencies into .venv (log: $log)"
+  if ! { .venv/bin/python -m pip install -q --upgrade pip &&
+         .venv/bin/python -m pip install -q -e '.[test]'; } >"$log" 2>&1; then
+    cat "$log" >&2
+    echo "[setup] the installation failed: the log is above and in $log" >&2
+    exit 1
+  fi
+  cat pyproject.toml setup.py >"$stamp"
 fi

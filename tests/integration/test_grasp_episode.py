@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from tg_drake.grasping.dgi import FINGERTIP_Y, PAD_CENTER_Y
-from tg_drake.grasping.episode import (EpisodeConfig, GraspWorld, run_grasp_batch,
-                                       scripted_targets)
+from tg_drake.simulation.episode import EpisodeConfig, GraspWorld, run_grasp_batch, scripted_targets
 from tg_drake.outcome import CLOSED_ON_AIR
 
 CYLINDER_SDF = """<?xml version="1.0"?>

@@ -1,11 +1,10 @@
 """A scripted grasp in the full station: the WSG closes on an object's body and the arm lifts it."""
 
-import numpy as np
 import pytest
 
 from tg_drake.objects import get_object
 from tg_drake.scenario import ObjectPlacement, Scenario
-from tg_drake.scripted import grasp_and_lift
+from tg_drake.simulation.scripted import grasp_and_lift
 from tg_drake.station import make_station
 
 

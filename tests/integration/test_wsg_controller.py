@@ -8,7 +8,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from tg_drake.station import make_parser
+from tg_drake.models import make_parser
 
 
 def test_schunk_wsg_position_controller_drives_our_model_to_a_width():

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import tempfile
 import time
+from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
@@ -19,14 +20,14 @@ import numpy as np
 from tg_drake.bench import Figure, figure
 from tg_drake.evaluation.paper import PAPER
 from tg_drake.perception.bench import object_times_ms
+from tg_drake.evaluation.cli import _run
+from tg_drake.evaluation.suite import load_suite
+from tg_drake.executor import Job, LocalExecutor, run_jobs
 
 N_CASES = 64
 
 
 def _sweep_seconds(cases, workers: int) -> float:
-    from tg_drake.evaluation.cli import _run
-    from tg_drake.executor import Job, LocalExecutor, run_jobs
-
     with tempfile.TemporaryDirectory() as folder:
         t0 = time.perf_counter()
         run_jobs(_run, [Job(c.key, c) for c in cases], out=Path(folder) / "results.jsonl",
@@ -36,10 +37,6 @@ def _sweep_seconds(cases, workers: int) -> float:
 
 def sweep_efficiency() -> Figure:
     """Seconds for the sweep with 2 workers (one run; reference: one run with 1 worker)."""
-    from importlib.resources import files
-
-    from tg_drake.evaluation.suite import load_suite
-
     suite = Path(str(files("tg_drake"))).parent / "scenarios" / "suites" / "s_real.yaml"
     cases = load_suite(suite)[1][:N_CASES]
     one = _sweep_seconds(cases, 1)

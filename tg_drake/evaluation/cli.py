@@ -20,12 +20,16 @@ import sys
 import zlib
 from pathlib import Path
 
+from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
+
+# Start-up: `tg-drake --help` imports this module, so the suite, scenario, table and job modules
+# (which import pydrake) are imported inside the functions that use them.
+
 HELP = "run evaluation suites (progress bar, resumable results.jsonl) and write the paper's tables"
 
 
 def add_arguments(parser) -> None:
-    from tg_drake.executor import EXECUTORS
-
     parser.add_argument("suites", type=Path, nargs="+", metavar="SUITE",
                         help="suite YAML files (scenarios/suites/)")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
@@ -53,7 +57,7 @@ def add_arguments(parser) -> None:
 def load_cases(paths) -> list:
     """The cases of several suites, executed runs grouped by scenario (their variants side by
     side, so that a sweep cut short still compares the variants on the scenarios it ran)."""
-    from tg_drake.evaluation.suite import load_suite
+    from tg_drake.evaluation.suite import load_suite  # start-up (pydrake)
 
     cases = []
     for path in paths:
@@ -63,7 +67,7 @@ def load_cases(paths) -> list:
 
 def suite_notes(paths) -> str:
     """A Markdown list of the suites: name, cases, description."""
-    from tg_drake.evaluation.suite import load_suite
+    from tg_drake.evaluation.suite import load_suite  # start-up (pydrake)
 
     lines = ["Suites:", ""]
     for path in paths:
@@ -73,8 +77,6 @@ def suite_notes(paths) -> str:
 
 
 def _ordered(cases) -> list:
-    from tg_drake.errors import ScenarioError
-
     keys = [c.key for c in cases]
     if len(set(keys)) != len(keys):
         dup = sorted({k for k in keys if keys.count(k) > 1})
@@ -89,7 +91,7 @@ def _ordered(cases) -> list:
 def read_records(out: Path, cases) -> list[dict]:
     """The records of `cases` in results.jsonl; a case recorded as an error becomes a record with
     its metadata and "error" (one per setting for a perceived case)."""
-    from tg_drake.evaluation.suite import DATASET_OF_SETTING
+    from tg_drake.evaluation.suite import DATASET_OF_SETTING  # start-up (pydrake)
 
     by_key = {c.key: c for c in cases}
     if not out.exists():
@@ -118,8 +120,8 @@ def read_records(out: Path, cases) -> list[dict]:
 
 def write_tables(out_dir: Path, records: list[dict], command: str, notes: str = "",
                  name: str = "tables") -> dict:
-    from tg_drake.evaluation.plots import save_plots
-    from tg_drake.evaluation.tables import compute, markdown
+    from tg_drake.evaluation.plots import save_plots  # start-up (pydrake)
+    from tg_drake.evaluation.tables import compute, markdown  # start-up (pydrake)
 
     tables = compute(records)
     tables["command"] = command
@@ -130,17 +132,12 @@ def write_tables(out_dir: Path, records: list[dict], command: str, notes: str = 
 
 
 def main(args) -> int:
-    from tg_drake.executor import Job, make_executor, run_jobs
-
     if not re.fullmatch(r"[\w.-]+", args.name):
-        from tg_drake.errors import ScenarioError
-
         raise ScenarioError(f"--name is a file stem (letters, digits, '_', '-', '.'), got "
                             f"{args.name!r}", field="--name")
     cases = load_cases(args.suites)
     if args.theory != "specific":
-        from tg_drake.errors import ScenarioError, unknown_name
-        from tg_drake.logic.theory import VARIANTS
+        from tg_drake.logic.theory import VARIANTS  # start-up (ProbLog)
 
         if args.theory not in VARIANTS:
             raise unknown_name("theory", args.theory, VARIANTS, error=ScenarioError,
@@ -177,6 +174,6 @@ def main(args) -> int:
 
 
 def _run(case):
-    from tg_drake.evaluation.jobs import run_case
+    from tg_drake.evaluation.jobs import run_case  # start-up (pydrake)
 
     return run_case(case)

@@ -20,8 +20,19 @@ import zlib
 
 import numpy as np
 
-from tg_drake.errors import PerceptionError, RuleError, TgDrakeError
-from tg_drake.types import CATEGORIES, TASKS
+from tg_drake.errors import RuleError, TgDrakeError
+from tg_drake.evaluation.suite import DATASET_OF_SETTING
+from tg_drake.kernels.database import load_database
+from tg_drake.kernels.library import sample_object
+from tg_drake.logic.engine import LogicEngine
+from tg_drake.logic.observations import Observations, count_handles, handle_count
+from tg_drake.logic.theory import TheoryConfig
+from tg_drake.objects import get_object, mesh
+from tg_drake.perception.ground_truth import interior_visible
+from tg_drake.perception.render import perceive
+from tg_drake.run import run_scenario
+from tg_drake.scenario import DgiScorer, LocalOnly, PipelineConfig, Scenario, TaskConfig, validate
+from tg_drake.types import CATEGORIES
 
 # Logic methods (the paper's columns, the paper's two ablations and ours): name → (category/task
 # theory, pre-grasp theory, prior[, "no_interior"]). Theories as (category model, grasp model, exclusive); the pre-grasp
@@ -46,9 +57,6 @@ CONFIDENT_PART = 0.5  # S_REAL: detected parts at least this likely are kept (as
 
 @functools.lru_cache(maxsize=None)
 def _engine(category: str, grasp: str, exclusive: bool):
-    from tg_drake.logic.engine import LogicEngine
-    from tg_drake.logic.theory import TheoryConfig
-
     return LogicEngine(TheoryConfig(category=category, grasp=grasp, exclusive=exclusive))
 
 
@@ -72,8 +80,6 @@ def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS,
     ground truth, its part distribution. `theory` stands in for the specific model variant (e.g.
     "learned"). An impossible observation (probability 0) is recorded as the error it is, with no
     distributions."""
-    from tg_drake.logic.observations import Observations
-
     def variant(models):
         return tuple(theory if m == "specific" else m for m in models[:2]) + models[2:]
 
@@ -103,8 +109,6 @@ def kernel_priors(points, normals, labels, *, object_id: str, t: int,
                   clouds: str = "perceived") -> dict:
     """Label fractions (T = 0) and Manifolds (T = t) priors, leave-one-object-out, against the
     database entries chosen for this kind of query cloud ("perceived" or "ground_truth")."""
-    from tg_drake.kernels.database import load_database
-
     db = load_database()
     entries, _ = db.choice(clouds)
     return {name: _round(db.prior(points, normals, labels, t=T, entries=entries,
@@ -117,12 +121,6 @@ def _seed(key: str, seed: int) -> int:
 
 
 def run_synthetic(case) -> dict:
-    from tg_drake.kernels.database import load_database
-    from tg_drake.kernels.library import sample_object
-    from tg_drake.logic.observations import Observations, handle_count
-    from tg_drake.objects import get_object, mesh
-    from tg_drake.perception.ground_truth import interior_visible
-
     placement = case.target_placement
     obj = get_object(placement.id)
     vertices, _, labels = mesh(obj)
@@ -141,45 +139,8 @@ def run_synthetic(case) -> dict:
                                        theory=case.theory)}
 
 
-# The default scenario camera relative to the object (tools/eval_kernel_prior.py perceives so too).
-P_CAMERA = (0.8, 0.0, 0.55)  # [m] eye, from the object's table point
-P_TARGET = (0.0, 0.0, 0.05)  # [m] looked-at point
-
-
-def perceive(object_id: str, pose: str, yaw_deg: float, *, p_camera=None, p_target=None):
-    """The perception stage's description of a library object alone on a table, from its depth
-    image ray cast (640×480, 45° vertical field of view) from the default camera's viewpoint
-    (or from `p_camera` looking at `p_target` [m], both from the object's table point)."""
-    import open3d as o3d
-
-    from tg_drake.objects import get_object, mesh
-    from tg_drake.perception.geometry import Intrinsics
-    from tg_drake.perception.pipeline import describe_scene
-    from tg_drake.perception.synthetic import look_at, render_depth, table_mesh
-
-    obj = get_object(object_id)
-    intrinsics = Intrinsics.from_fov(640, 480, np.deg2rad(45.0))
-    X_WC = look_at(np.array(P_CAMERA if p_camera is None else p_camera, dtype=float),
-                   np.array(P_TARGET if p_target is None else p_target, dtype=float))
-    c, s = np.cos(np.deg2rad(yaw_deg)), np.sin(np.deg2rad(yaw_deg))
-    X_WO = np.eye(4)
-    X_WO[:2, :2] = [[c, -s], [s, c]]
-    X_WO = X_WO @ obj.resting_pose(pose).X_TO
-    V, F, _ = mesh(obj)
-    m = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(np.array(V, float)),
-                                  o3d.utility.Vector3iVector(np.array(F, np.int32)))
-    m.transform(X_WO)
-    scene = describe_scene(render_depth([table_mesh(), m], intrinsics, X_WC), intrinsics, X_WC)
-    if not scene.objects:
-        raise PerceptionError("no object found on the table")
-    p_com = (X_WO @ np.r_[obj.com, 1.0])[:2]  # the cluster nearest to the object's centre
-    return min(scene.objects, key=lambda o: np.linalg.norm(o.p_W[:, :2].mean(axis=0) - p_com))
-
-
 def setting_observations(description, setting: str, *, true_pose: str, containment: str):
     """Observations of a perceived object in one of the paper's S_REAL settings."""
-    from tg_drake.logic.observations import Observations, count_handles
-
     detected = {p: float(v) for p, v in description.part_probabilities.items() if v > 0}
     if setting == "semi":
         parts, pose = {p: 1.0 for p in detected}, {true_pose: 1.0}
@@ -194,9 +155,6 @@ def setting_observations(description, setting: str, *, true_pose: str, containme
 
 
 def run_perceived(case) -> list[dict]:
-    from tg_drake.evaluation.suite import DATASET_OF_SETTING
-    from tg_drake.objects import get_object
-
     placement = case.target_placement
     obj = get_object(placement.id)
     meta = case.meta()
@@ -224,10 +182,6 @@ def run_perceived(case) -> list[dict]:
 
 
 def run_executed(case) -> dict:
-    from tg_drake.run import run_scenario
-    from tg_drake.scenario import (DgiScorer, LocalOnly, PipelineConfig, Scenario, TaskConfig,
-                                   validate)
-
     pipeline = PipelineConfig(scoring=LocalOnly() if case.variant == "local" else DgiScorer())
     pipeline.logic.category = pipeline.logic.grasp = case.theory
     pipeline.logic.use_prior = case.variant != "pipeline_uniform"

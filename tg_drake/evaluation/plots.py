@@ -19,6 +19,8 @@ DPI = 80  # small files for the repository
 
 
 def _plt():
+    # matplotlib when a plot is drawn, not when tables are computed: its import is slow, and the
+    # backend is chosen before pyplot loads.
     import matplotlib
 
     matplotlib.use("Agg")

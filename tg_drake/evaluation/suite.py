@@ -23,14 +23,18 @@ own (`task.ground_truth`, with its reason). `load_suite` checks every name and r
 naming the file, the field and the allowed values.
 """
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import yaml
+from pydrake.common.yaml import yaml_load_typed
 
 from tg_drake.errors import ScenarioError, unknown_name
-from tg_drake.scenario import ObjectPlacement, TaskConfig
+from tg_drake.objects import get_object, load_library
+from tg_drake.scenario import ObjectPlacement, Scenario, TaskConfig, validate
 from tg_drake.types import CATEGORIES, CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 KINDS = ("synthetic", "perceived", "executed")
@@ -163,8 +167,6 @@ class Case:
 
     def meta(self) -> dict:
         """The case as JSON (part of every record it gives)."""
-        from tg_drake.objects import get_object
-
         p = self.target_placement
         return {"suite": self.suite, "kind": self.kind, "dataset": self.dataset,
                 "variant": self.variant, "object": p.id, "pose": p.pose, "yaw": p.yaw,
@@ -177,8 +179,6 @@ class Case:
 
 
 def _load_typed(cls, path: Path):
-    from pydrake.common.yaml import yaml_load_typed
-
     if not path.is_file():
         raise ScenarioError("no such suite file", file=str(path))
     try:
@@ -280,8 +280,6 @@ def _can_hold_water(obj, pose: str) -> bool:
 
 
 def _generated(suite: Suite, gt: GroundTruthTables, where: str, gt_where: str) -> list[Case]:
-    from tg_drake.objects import load_library
-
     g = suite.generator
     library = load_library()
     chosen = []
@@ -352,10 +350,6 @@ def _generated(suite: Suite, gt: GroundTruthTables, where: str, gt_where: str) -
 def _drawn(suite: Suite, product: list[Case], library) -> list[Case]:
     """`generator.sample` cases drawn from the product with the suite's seed: categories in turn,
     then a case of that category (its variants together), moved by the spreads."""
-    import dataclasses
-
-    import numpy as np
-
     g = suite.generator
     rng = np.random.default_rng(suite.seed)
     by_scenario: dict[str, list[Case]] = {}
@@ -385,9 +379,6 @@ def _drawn(suite: Suite, product: list[Case], library) -> list[Case]:
 
 
 def _scenes(suite: Suite, where: str) -> list[Case]:
-    from tg_drake.objects import get_object
-    from tg_drake.scenario import Scenario, validate
-
     cases = []
     for i, scene in enumerate(suite.scenes):
         f = f"scenes[{i}]"

@@ -1,6 +1,6 @@
 """How repeatable is a physics grasp label? The ceiling of any classifier trained on such labels.
 
-tools/label_noise.py executes recorded grasps again (`tg_drake.grasping.episode`): with the same
+tools/label_noise.py executes recorded grasps again (`tg_drake.simulation.episode`): with the same
 gripper pose, and "nudged" — the pose moved a millimetre and turned a degree (`nudge`), a change
 far below the perception's 4 mm resolution. This module holds the
 pure parts: the stratified sample, the nudge, and the analysis of the repeated labels.
@@ -19,6 +19,7 @@ from collections import defaultdict
 from collections.abc import Callable
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from tg_drake.errors import GraspingError, unknown_name
 from tg_drake.grasping.dgi import PAD_CENTER_Y
@@ -63,8 +64,6 @@ def nudge(X_WG: np.ndarray, rng: np.random.Generator, *, distance: float, angle:
           ) -> np.ndarray:
     """X_WG turned by `angle` [rad] about a random axis through its grasp point (the pads'
     centre, PAD_CENTER_Y along y_G), which moves `distance` [m] in a random direction."""
-    from scipy.spatial.transform import Rotation
-
     X_WG = np.asarray(X_WG, dtype=float)
     if X_WG.shape != (4, 4):
         raise GraspingError(f"X_WG must be a 4×4 pose, got shape {X_WG.shape}")

@@ -41,7 +41,7 @@ def _inputs():
 
 def kernel_query_ms() -> Figure:
     """Milliseconds for one category prior against the database (median of 20)."""
-    from grakel.kernels import Propagation
+    from grakel.kernels import Propagation  # optional (the test extra): only the reference
 
     clouds, ids, cats, projections = _inputs()
     query, held_out = clouds[0], ids[0]
@@ -62,7 +62,7 @@ def kernel_query_ms() -> Figure:
 
 def kernel_loo_s() -> Figure:
     """Seconds for the leave-one-out kernel matrices K_0..K_15 of all database graphs."""
-    from grakel.kernels import Propagation
+    from grakel.kernels import Propagation  # optional (the test extra): only the reference
 
     clouds, _, _, projections = _inputs()
 

@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from tg_drake.kernels.database import ENTRIES
 from tg_drake.kernels.prior import N_NEIGHBOURS, category_priors, is_correct, true_category_rank
 from tg_drake.types import CATEGORIES
 
@@ -144,8 +145,6 @@ def evaluate_members(db, queries, *, entries=None, t_values=None,
     `KernelDatabase`) used as queries: each is compared only with the graphs of other objects,
     and the choice of entries (default: all of `ENTRIES`) and T is made per held-out object on
     the other objects alone (`nested_leave_one_object_out`)."""
-    from tg_drake.kernels.database import ENTRIES
-
     queries = np.asarray(queries, dtype=np.int64)
     entries = ENTRIES if entries is None else entries
     return nested_leave_one_object_out(

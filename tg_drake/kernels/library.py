@@ -20,7 +20,10 @@ import hashlib
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from tg_drake.errors import PerceptionError
 from tg_drake.kernels.graph import LabelledCloud, size_normalised, voxel_resample
+from tg_drake.objects import get_object, load_library, mesh, sample_surface
+from tg_drake.perception.render import P_CAMERA, P_TARGET, perceive
 from tg_drake.types import CATEGORIES
 
 SPACING = 0.05  # database voxel size as a fraction of the object's size (clouds are scaled to a
@@ -31,8 +34,6 @@ OVERSAMPLING = 3.0  # surface samples are drawn at SPACING / OVERSAMPLING before
 def sample_object(obj, *, spacing: float = SPACING, rng: np.random.Generator) -> LabelledCloud:
     """One resampled labelled cloud of a library object (a `tg_drake.objects.LibraryObject`),
     scaled to unit size (`graph.size_normalised`); `spacing` is relative to that size."""
-    from tg_drake.objects import sample_surface
-
     size = float(max(obj.extents))
     p, n, labels = sample_surface(obj, spacing=size * spacing / OVERSAMPLING, rng=rng)
     R = Rotation.random(rng=rng).as_matrix()
@@ -46,8 +47,6 @@ def library_clouds(*, n_samplings: int, spacing: float = SPACING, rng: np.random
 
     Returns (clouds, object ids, category indices), one entry per cloud.
     """
-    from tg_drake.objects import get_object, load_library
-
     objects = list(load_library().values()) if object_ids is None else \
         [get_object(i) for i in object_ids]
     clouds, ids, cats = [], [], []
@@ -60,27 +59,23 @@ def library_clouds(*, n_samplings: int, spacing: float = SPACING, rng: np.random
 
 
 # Viewpoints of the perceived entries: camera eye [m] from the object's table point, looking at
-# `VIEW_TARGET`. The first is the default scenario camera's (`tg_drake.evaluation.jobs.P_CAMERA`);
-# the others are lower and closer, and higher and farther.
-VIEWPOINTS = ((0.8, 0.0, 0.55), (0.65, 0.0, 0.40), (0.9, 0.0, 0.80))
-VIEW_TARGET = (0.0, 0.0, 0.05)
+# `VIEW_TARGET`. The first is the default scenario camera's; the others are lower and closer, and
+# higher and farther.
+VIEWPOINTS = (P_CAMERA, (0.65, 0.0, 0.40), (0.9, 0.0, 0.80))
+VIEW_TARGET = P_TARGET
 VIEW_YAWS_DEG = (0.0, 60.0, 120.0, 180.0, 240.0, 300.0)  # object turns about the table normal.
 
 
 def perceived_views(*, object_ids=None, viewpoints=VIEWPOINTS, yaws_deg=VIEW_YAWS_DEG,
                     progress=None) -> tuple[list[dict], list[dict]]:
     """Perceived clouds of library objects, one per resting pose × viewpoint × yaw
-    (`tg_drake.evaluation.jobs.perceive`: the depth image ray cast, then `describe_scene`).
+    (`tg_drake.perception.render.perceive`: the depth image ray cast, then `describe_scene`).
 
     Returns (views, failures) in library order. A view is a dict with object, category, pose,
     yaw, view (index into `viewpoints`) and description (the perceived `ObjectDescription`);
     a failure has a reason instead (perception found no object). `progress(done, total)` is
     called after each view.
     """
-    from tg_drake.errors import PerceptionError
-    from tg_drake.evaluation.jobs import perceive
-    from tg_drake.objects import get_object, load_library
-
     objects = list(load_library().values()) if object_ids is None else \
         [get_object(i) for i in object_ids]
     jobs = [(obj, pose, v, yaw) for obj in objects for pose in obj.poses
@@ -102,8 +97,6 @@ def perceived_views(*, object_ids=None, viewpoints=VIEWPOINTS, yaws_deg=VIEW_YAW
 def library_fingerprint() -> str:
     """SHA-256 of what the database depends on: every object's id, category, mesh and part
     labels, in library order. A database whose fingerprint differs is stale."""
-    from tg_drake.objects import load_library, mesh
-
     digest = hashlib.sha256()
     for obj in load_library().values():
         V, F, L = mesh(obj)

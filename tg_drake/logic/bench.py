@@ -9,14 +9,13 @@ once per query (`tg_drake.logic.engine.reference_query`), as a user of ProbLog w
 from __future__ import annotations
 
 from tg_drake.bench import Figure, figure, median_time
+from tg_drake.logic.engine import LogicEngine, reference_query
+from tg_drake.logic.observations import Observations
+from tg_drake.logic.theory import TheoryConfig, rules_dir
 
 
 def logic_scene_ms() -> Figure:
     """Milliseconds for the three queries of one scene (median of 200; reference median of 5)."""
-    from tg_drake.logic.engine import LogicEngine, reference_query
-    from tg_drake.logic.observations import Observations
-    from tg_drake.logic.theory import TheoryConfig, rules_dir
-
     obs = Observations.from_file(rules_dir() / "examples" / "fig1_cup.yaml")
     config = TheoryConfig()
     engine = LogicEngine(config)

@@ -7,6 +7,7 @@ rules/examples/fig1_cup.yaml.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -30,8 +31,7 @@ def add_arguments(parser) -> None:
 
 
 def main(args) -> int:
-    import dataclasses
-
+    # Start-up: `tg-drake --help` imports this module; ProbLog takes a second to import.
     from tg_drake.logic.engine import QUERIES, LogicEngine
     from tg_drake.logic.observations import Observations
     from tg_drake.logic.theory import TheoryConfig

@@ -36,9 +36,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from problog import get_evaluatable
+from problog.errors import InconsistentEvidenceError
 from problog.formula import LogicDAG, LogicFormula
 from problog.logic import Term
 from problog.program import SimpleProgram
+from pysdd.sdd import SddManager, Vtree
 
 from tg_drake.errors import RuleError
 from tg_drake.logic.circuit import Circuit
@@ -158,8 +161,6 @@ def compile_sdd(dag: LogicDAG, root_keys: list, evidence_key) -> tuple[Circuit, 
     second where the default balanced vtree over ProbLog's atom order took 15-20 s.
     Returns the circuit, the atom name of each variable (1-based order), and the SDD size.
     """
-    from pysdd.sdd import SddManager, Vtree
-
     order: list[int] = []
     seen: set[int] = set()
     stack = [abs(k) for k in reversed([evidence_key, *root_keys]) if k]
@@ -434,9 +435,6 @@ def reference_query(obs: Observations, config: TheoryConfig = TheoryConfig(), *,
     """The same answers from plain ProbLog: the scene as a program, ground, compiled and
     evaluated once per query (no explanations). `with_evidence` also computes P(e) (one more
     grounding); otherwise `evidence` is NaN."""
-    from problog import get_evaluatable
-    from problog.errors import InconsistentEvidenceError
-
     theory = plain_clauses(load_theory(config, directory))
     scene = observation_clauses(obs)
     atoms = _ATOMS[config.exclusive]

@@ -68,12 +68,16 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from problog.logic import AnnotatedDisjunction, Clause, Constant, Not, Term, Var
+from problog import get_evaluatable
+from problog.errors import InconsistentEvidenceError
+from problog.learning.lfi import LFIProblem
+from problog.logic import And, AnnotatedDisjunction, Clause, Constant, Not, Term, Var
+from problog.program import SimpleProgram
 
 from tg_drake.errors import RuleError, unknown_name
 from tg_drake.logic.names import OBJECT, TASK_ATOMS
 from tg_drake.logic.observations import observation_schema
-from tg_drake.logic.theory import SourceClause, TheoryConfig, load_theory, rules_dir
+from tg_drake.logic.theory import SourceClause, _load_file, rules_dir
 from tg_drake.types import CATEGORIES, CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 MODELS: tuple[str, ...] = ("grasp", "category")
@@ -359,8 +363,6 @@ def _unstick(q: list[float]) -> list[float]:
 
 
 def _and(literals: list[Term]) -> Term:
-    from problog.logic import And
-
     return And.from_list(literals)
 
 
@@ -370,8 +372,6 @@ def _head_functor(clause: Term) -> str:
 
 
 def _load(path: Path) -> list[SourceClause]:
-    from tg_drake.logic.theory import _load_file
-
     return _load_file(path)
 
 
@@ -438,10 +438,6 @@ def fit(interpretations: Sequence[Interpretation], *, model: str = "grasp",
     Interpretations whose evidence the theory makes impossible (a served grasp it has no rule
     for in that scene) are dropped and listed (`FitResult.dropped`).
     """
-    from problog.errors import InconsistentEvidenceError
-    from problog.learning.lfi import LFIProblem
-    from problog.program import SimpleProgram
-
     if prior_strength < 0:
         raise RuleError(f"prior_strength must be >= 0, got {prior_strength}",
                         field="prior_strength")
@@ -514,10 +510,6 @@ def _analyse(interpretations, tunables, program) -> tuple[list, list[str], list[
     evidence is possible at all (else the interpretation is dropped: a served grasp the theory
     has no rule for in that scene), and for each tunable clause whether some grounding of its
     body holds for certain (then its probability is data-driven; the count is reported)."""
-    from problog import get_evaluatable
-    from problog.errors import InconsistentEvidenceError
-    from problog.program import SimpleProgram
-
     counts = [0] * len(tunables)
     bodies = [_body(t.term) for t in tunables]
     groups: dict = {}

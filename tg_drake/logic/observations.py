@@ -26,7 +26,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from problog.logic import AnnotatedDisjunction, Clause, Constant, Not, Term
+import yaml
+from problog.logic import And, AnnotatedDisjunction, Clause, Constant, Not, Term
 
 from tg_drake.errors import RuleError, unknown_name
 from tg_drake.logic.names import OBJECT, TASK_ATOMS
@@ -192,8 +193,6 @@ class Observations:
     @classmethod
     def from_file(cls, path: str | Path) -> Observations:
         """From a YAML observations file; a malformed file raises RuleError naming it."""
-        import yaml
-
         path = Path(path)
         try:
             data = yaml.safe_load(path.read_text())
@@ -414,6 +413,4 @@ def _schema_heads() -> list[Term]:
 
 
 def _conjunction(literals: list[Term]) -> Term:
-    from problog.logic import And
-
     return And.from_list(literals)

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from problog.errors import ProbLogError
-from problog.logic import And, AnnotatedDisjunction, Clause, Constant, Not, Term
+from problog.logic import And, AnnotatedDisjunction, Clause, Constant, Not, Term, Var, list2term
 from problog.program import PrologFile
 
 from tg_drake.errors import RuleError, unknown_name
@@ -263,12 +263,8 @@ def _literals(body: Term) -> list[Term]:
 
 
 def _var(name: str):
-    from problog.logic import Var
-
     return Var(name)
 
 
 def _list_term(items: list) -> Term:
-    from problog.logic import list2term
-
     return list2term(items)

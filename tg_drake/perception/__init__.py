@@ -12,6 +12,8 @@ Modules, each pure (arrays in, arrays out; no Drake systems):
 - `pipeline`: `describe_scene` (depth frame) and `describe_object` / `describe_cloud` (points);
 - `ground_truth`: the same description from the object library's labels (synthetic setting);
 - `plot`: part-coloured PNGs; `synthetic`: known shapes and ray-cast depth for tests;
+- `render`: a library object alone on a table, ray cast from the default camera and perceived
+  (how the evaluation's perceived suites and the kernel database's perceived entries see it);
 - `config`: every parameter, one dataclass per step; `bench`: the speed figures.
 
 The Drake systems are in `tg_drake.systems.perception_system`.

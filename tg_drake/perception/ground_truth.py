@@ -14,6 +14,7 @@ import functools
 import numpy as np
 
 from tg_drake.errors import PerceptionError
+from tg_drake.objects import get_object, sample_surface
 from tg_drake.perception.config import PregraspConfig
 from tg_drake.perception.geometry import check_transform, make_transform, rotate, transform
 from tg_drake.perception.pregrasp import part_pregrasps
@@ -66,8 +67,6 @@ def open_top(p_O: np.ndarray, labels: np.ndarray) -> bool:
 def library_open_top(obj_id: str, seed: int = 0) -> bool:
     """`open_top` of a library object, on a sampling of 4,000 surface points drawn with `seed`
     (a property of the object, not of a run: the default sampling is the one the labels use)."""
-    from tg_drake.objects import get_object, sample_surface
-
     p_O, _, labels = sample_surface(get_object(obj_id), n=4000,
                                     rng=np.random.default_rng(seed))
     return open_top(p_O, labels)
@@ -77,8 +76,6 @@ def interior_visible(obj_id: str, pose: str) -> float:
     """The perfect `interior_seen` observation of a library object in a pose: 1 for an open
     container unless it stands upside down (its opening on the table, out of any camera's sight),
     else 0 (tools too)."""
-    from tg_drake.objects import get_object
-
     if get_object(obj_id).is_tool or pose == "upsidedown":
         return 0.0
     return float(library_open_top(obj_id))
@@ -103,8 +100,6 @@ def describe_library_object(obj_id: str, X_WO: np.ndarray, X_WT: np.ndarray, *,
     z along the symmetry axis towards the top (a tool: from the handle to the usable area, the
     library's x), x towards the handle (a tool: the library's z, up).
     """
-    from tg_drake.objects import get_object, sample_surface
-
     obj = get_object(obj_id)
     X_WO = check_transform(X_WO, "X_WO")
     X_WT = check_transform(X_WT, "X_WT")

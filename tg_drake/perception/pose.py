@@ -128,7 +128,7 @@ def interior_seen(pose: PoseEstimate, is_tool: bool, cfg: PoseConfig | None = No
     `interior_seen` observation of the theory; 0 when it did not, or for a tool).
 
     The evidence is the cavity cue's: visible surface facing into the object. On depth images of
-    our library from the S_REAL suite's viewpoint (`tg_drake.evaluation.jobs.perceive`: 44
+    our library from the S_REAL suite's viewpoint (`tg_drake.perception.render.perceive`: 44
     objects in each of their poses at yaws 0, 120, 240) its share of the visible body points is
     at most 0.06 on cans and bottles in any pose (a can's lid rim) and at least 0.17 on every
     upright glass, cup, bowl, pot and pan and every one lying with its opening towards the

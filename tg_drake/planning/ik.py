@@ -11,28 +11,25 @@ smallest signed distance of a configuration for checking a path after it is plan
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
-from pydrake.geometry import Box, Cylinder, CollisionFilterDeclaration, GeometrySet
+from pydrake.geometry import Box, CollisionFilterDeclaration, Cylinder, GeometrySet
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.inverse_kinematics import InverseKinematics
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction
+from pydrake.multibody.plant import CoulombFriction
 from pydrake.multibody.tree import SpatialInertia
+from pydrake.planning import RobotDiagramBuilder
 from pydrake.solvers import SnoptSolver, Solve, SolverOptions
-from pydrake.systems.framework import DiagramBuilder
 
 from tg_drake.robot import (IIWA_HOME, IIWA_JOINT_NAMES, WSG_BODY, WSG_FINGER_JOINTS, WSG_FINGERS,
                             WSG_MAX_OPENING)
-from tg_drake.table import add_table
+from tg_drake.robot_plants import add_scenario_models
+from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, add_table
 
-if TYPE_CHECKING:
-    from tg_drake.scenario import Scenario
 
 # The scenario's models in the planning plant: the robot and the gripper (the table is added from
 # the scenario's table_size); loose objects become obstacles if at all.
 PLANNING_MODELS = ("iiwa", "wsg")
-
 
 # Weight of the IK's pull towards its seed [1/rad²]: a preference among the solutions that meet
 # the (hard) pose and clearance constraints.
@@ -59,7 +56,7 @@ class ArmPlant:
         return q
 
 
-def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
+def make_arm_plant(scenario = None, *, obstacles=(),
                    finger_opening: float = WSG_MAX_OPENING, held=None,
                    finger_contact=()) -> ArmPlant:
     """A kinematic model of the arm for IK and collision checking.
@@ -73,16 +70,13 @@ def make_arm_plant(scenario: Scenario | None = None, *, obstacles=(),
         or released: its box is a bounding box, and the fingers close on the object inside it);
         the rest of the arm and gripper still keeps clear of them.
     """
-    # The scenario schema composes the planner's config, which imports this module: the builder
-    # of the scenario's models (which reads the schema) is imported when a plant is made.
-    from tg_drake.robot_plants import add_scenario_models
-    from tg_drake.scenario import Scenario
-
-    scenario = scenario or Scenario()
-    builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    builder = RobotDiagramBuilder(time_step=0.0)
+    plant, scene_graph = builder.plant(), builder.scene_graph()
     add_scenario_models(plant, scenario, PLANNING_MODELS)
-    add_table(plant, scenario.table_size, scenario.X_WT.GetDeterministicValue())
+    if scenario is not None:
+        add_table(plant, scenario.table_size, scenario.X_WT.GetDeterministicValue())
+    else:  # the station's default table
+        add_table(plant, TABLE_SIZE, X_WT_DEFAULT)
     # Fix the fingers at the given opening: weld-like by locking their joints in IK (bounds).
     world = plant.world_body()
     added = []

@@ -1,8 +1,8 @@
 """One grasp, executed in physics: a free-floating WSG 50 approaches, closes, lifts and shakes.
 
-This module labels training data for the DGI classifier (tools/collect_grasps.py). It is the one
-module under tg_drake/grasping/ that builds a Drake diagram; the cores (dgi.py, svm.py,
-hypotheses.py) never import it.
+This module labels training data for the DGI classifier (tools/collect_grasps.py). It builds and
+simulates a Drake diagram, so it lives beside the station, not in the grasping core (dgi.py,
+svm.py, hypotheses.py), which never imports it.
 
 The world: the table of models/table/table.sdf with its top at z_W = 0, one object resting on it,
 and the WSG 50 of models/wsg_50/wsg_50.sdf carried by six actuated joints — three prismatic and

@@ -18,12 +18,14 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from tg_drake.errors import PlanningError
+from tg_drake.bench import Figure
+from tg_drake.errors import PlanningError, SimulationError
+from tg_drake.objects import get_object
 from tg_drake.outcome import CLOSED_ON_AIR
 from tg_drake.planning.ik import make_arm_plant, solve_ik
 from tg_drake.planning.planner import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.robot import IIWA_HOME, WSG_BODY, WSG_MAX_OPENING
-from tg_drake.scenario import Scenario
+from tg_drake.scenario import InverseDynamicsDriver, ObjectPlacement, Scenario
 from tg_drake.station import add_station, rotation_from_axes
 
 
@@ -114,7 +116,6 @@ def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: flo
 
     X_WO = body.EvalPoseInWorld(plant_context)
     if not np.all(np.isfinite(X_WO.GetAsMatrix4())):
-        from tg_drake.errors import SimulationError
         raise SimulationError("the simulation diverged (non-finite object pose)")
     q_wsg = plant.GetPositions(plant_context, station.instances["wsg"])
     opening = float(q_wsg[1] - q_wsg[0])
@@ -137,10 +138,6 @@ def bench_sim_rtf():
     (6.5 s simulated), one camera frame rendered at its start. The reference is the same run with
     Drake's explicit inverse-dynamics arm controller at a 2 ms step; `speedup` = ours / reference
     (a rate: higher is better)."""
-    from tg_drake.bench import Figure
-    from tg_drake.objects import get_object
-    from tg_drake.scenario import InverseDynamicsDriver, ObjectPlacement
-
     def run(explicit: bool) -> float:
         scenario = Scenario()
         scenario.objects = [ObjectPlacement(id="can_02", pose="upright", yaw=90,
