@@ -30,6 +30,7 @@ from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.sensors import CameraConfig
 
 from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.systems.supervisor import SupervisorConfig
 from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 # Where the table-top frame T sits in the world (its surface at the iiwa base height). Its centre
@@ -198,14 +199,12 @@ class PipelineConfig:
     use_prior: bool = True  # the kernel prior feeds the logic (PLM); False: uniform (PLM_uniform)
     prior_floor: float = 0.02  # the logic sees (1 − floor)·prior + floor/11: a perceived object's
     # kernel prior can miss its category, and a zero there would make the evidence impossible
-    planning_start: float = 0.05  # [s] simulated time of the first planning event
-    max_requeries: int = 3  # re-queries of the logic with collision(Part) evidence
-    min_grasp_probability: float = 0.03  # below this P(some part is grasped | observations), the
-    # logic is taken to rule grasping out (an upside-down pan: 0.015; the paper's Fig. 1 cup: 0.13)
     grasp_selection: str = "pipeline"  # how hypotheses are ranked: "pipeline" (P(part | task) ·
     # P(grasp | local shape)) or "local_only" (P(grasp | local shape) alone, the paper's Local)
     grasp_part: str | None = None  # only hypotheses of this PART_LABELS part are tried, ranked by
     # the DGI's P(grasp | shape) alone (the logic may give the part 0): for data collection
+    supervisor: SupervisorConfig = field(default_factory=SupervisorConfig)  # the closed loop:
+    # gate, re-queries, waiting for plans, execution monitor
 
     def validate(self, where: str = "pipeline") -> None:
         if self.perception not in PERCEPTION_MODES:
@@ -221,6 +220,7 @@ class PipelineConfig:
         if self.grasp_part is not None and self.grasp_part not in PART_LABELS:
             raise unknown_name("part", self.grasp_part, PART_LABELS, error=ScenarioError,
                                field=f"{where}.grasp_part")
+        self.supervisor.validate(f"{where}.supervisor")
 
 
 @dataclass
