@@ -111,6 +111,7 @@ def _scenario(spec: dict, *, task: str, grasp_part: str | None = None, theory: s
         TaskConfig,
         validate,
     )
+    from tg_drake.systems.supervisor import SupervisorConfig
 
     scenario = Scenario(
         objects=[ObjectPlacement(id=spec["id"], pose=spec["pose"], xy=spec["xy"],
@@ -118,7 +119,8 @@ def _scenario(spec: dict, *, task: str, grasp_part: str | None = None, theory: s
         task=TaskConfig(task=task, place_xy=PLACE_XY),
         pipeline=PipelineConfig(perception="ground_truth", grasp_part=grasp_part,
                                 category_theory=theory, grasp_theory=theory,
-                                min_grasp_probability=0.0 if grasp_part else 0.03))
+                                supervisor=SupervisorConfig(
+                                    min_grasp_probability=0.0 if grasp_part else 0.03)))
     validate(scenario, where=spec["name"])
     return scenario
 
