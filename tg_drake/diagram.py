@@ -6,8 +6,8 @@
 
 The same builder is the public way to compose our systems with your own: `add_pipeline` returns
 every system it added (`pipeline.perception`, `.prior`, `.logic`, `.scoring`, `.planner`,
-`.supervisor` and the `station`), so you can add systems of yours to the same builder and connect them to any port — or
-call `add_station` alone and wire only the stages you want.
+`.supervisor` and the `station`), so you can add systems of yours to the same builder and connect
+them to any port — or call `add_station` alone and wire only the stages you want.
 
 Wiring (DESIGN.md, "The diagram"):
 

@@ -24,7 +24,8 @@ import time
 from pathlib import Path
 
 from tg_drake.errors import TgDrakeError
-from tg_drake.report import Pictures, Stages, evaluate_stages, final_stages, result_of, summary, write
+from tg_drake.report import (Pictures, Stages, evaluate_stages, final_stages, result_of, summary,
+                             write)
 from tg_drake.systems.supervisor import (FAILURE_REASONS, OUTCOME_STATUSES, Outcome, Reason,
                                          Status, outcome_of_error)
 

@@ -3,7 +3,8 @@
 `scenarios/regression/expected.yaml` holds, per scenario, the category argmax, the set the best
 task(s) must lie in, the part, the least accepted outcome and the tolerance for what may vary. Each
 scenario runs once per session (end to end, about 10–25 s, shared with the other scenario tests);
-each aspect is its own test, so a known failure of one aspect (`known_failure`, an expected failure, strict) does not hide the others.
+each aspect is its own test, so a known failure of one aspect (`known_failure`, an expected
+failure, strict) does not hide the others.
 """
 
 from pathlib import Path
