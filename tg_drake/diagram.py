@@ -5,9 +5,9 @@
     diagram = builder.Build()
 
 The same builder is the public way to compose our systems with your own: `add_pipeline` returns
-every system it added (`pipeline.perception`, `.prior`, `.logic`, `.scoring`, `.planner`, and the
-`station`), so you can add systems of yours to the same builder and connect them to any port — or
-call `add_station` alone and wire only the stages you want.
+every system it added (`pipeline.perception`, `.prior`, `.logic`, `.scoring`, `.planner`,
+`.supervisor` and the `station`), so you can add systems of yours to the same builder and connect
+them to any port — or call `add_station` alone and wire only the stages you want.
 
 Wiring (DESIGN.md, "The diagram"):
 
@@ -16,8 +16,14 @@ Wiring (DESIGN.md, "The diagram"):
     scene_description ─▶ prior ─▶ category_prior
     scene_description, category_prior, task, collisions ─▶ logic ─▶ grasp_semantics
     scene_description, grasp_semantics ─▶ scoring ─▶ ranked_grasps
-    scene_description, ranked_grasps, iiwa.state ─▶ planner ─▶ iiwa.desired_state, wsg.position
-    planner.collisions ─▶ logic.collisions   (the closed loop: unreachable parts become evidence)
+    scene_description, ranked_grasps, iiwa.state, plan_request ─▶ planner ─▶ iiwa.desired_state,
+        wsg.position, plan_status
+    scene_description, grasp_semantics, ranked_grasps, plan_status, wsg.state, body_poses,
+        contact_results ─▶ supervisor ─▶ collisions (─▶ logic), plan_request (─▶ planner), outcome
+
+The supervisor closes the loop (unreachable parts become collision evidence, the logic's veto is
+checked after every re-query) and judges the execution: simulate until
+``pipeline.ports["outcome"]`` is final.
 """
 
 from __future__ import annotations
@@ -38,6 +44,7 @@ from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.kernel_prior_system import KernelPriorSystem
 from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
 from tg_drake.systems.perception_system import GroundTruthPerception, PerceptionSystem
+from tg_drake.systems.supervisor import MonitorModel, Supervisor
 from tg_drake.targeting import select_target
 from tg_drake.types import SceneDescription
 
@@ -77,6 +84,7 @@ class Pipeline:
     logic: LeafSystem
     scoring: LeafSystem
     planner: LeafSystem
+    supervisor: LeafSystem
     task: LeafSystem
     config: PipelineConfig
     ports: dict = field(default_factory=dict)  # stage output ports by name
@@ -132,26 +140,45 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     scoring.GetInputPort("grasp_semantics"))
 
-    # Planner and execution; the closed loop back to the logic.
+    # Planner and execution; the supervisor closes the loop back to the logic and judges.
+    supervision = config.supervisor
     X_WT = scenario.X_WT.GetDeterministicValue()
     place_xy_W = (X_WT @ np.array([*scenario.task.place_xy, 0.0, 1.0]))[:2]
     planner = builder.AddNamedSystem("planner", GraspPlanner(
-        place_xy=place_xy_W, start_time=config.planning_start, config=config.planner,
-        max_requeries=config.max_requeries, scenario=scenario))
+        place_xy=place_xy_W, start_time=supervision.planning_start + supervision.period,
+        config=config.planner, scenario=scenario))
     builder.Connect(scene, planner.GetInputPort("scene_description"))
     builder.Connect(scoring.GetOutputPort("ranked_grasps"), planner.GetInputPort("ranked_grasps"))
     builder.Connect(station.outputs["iiwa.state"], planner.GetInputPort("iiwa.state"))
     builder.Connect(planner.GetOutputPort("iiwa.desired_state"),
                     station.inputs["iiwa.desired_state"])
     builder.Connect(planner.GetOutputPort("wsg.position"), station.inputs["wsg.position"])
-    builder.Connect(planner.GetOutputPort("collisions"), logic.GetInputPort("collisions"))
+
+    plant = station.plant
+    supervisor = builder.AddNamedSystem("supervisor", Supervisor(
+        config=supervision, model=MonitorModel.from_plant(
+            plant, object_body=station.object_body(target_placement.instance_name),
+            wsg_instance=station.instances["wsg"], table_instance=station.instances["table"],
+            p_OC=box_centre(target_placement.id))))
+    builder.Connect(scene, supervisor.GetInputPort("scene_description"))
+    builder.Connect(logic.GetOutputPort("grasp_semantics"),
+                    supervisor.GetInputPort("grasp_semantics"))
+    builder.Connect(scoring.GetOutputPort("ranked_grasps"),
+                    supervisor.GetInputPort("ranked_grasps"))
+    builder.Connect(planner.GetOutputPort("plan_status"), supervisor.GetInputPort("plan_status"))
+    for name in ("wsg.state", "body_poses", "contact_results"):
+        builder.Connect(station.outputs[name], supervisor.GetInputPort(name))
+    builder.Connect(supervisor.GetOutputPort("collisions"), logic.GetInputPort("collisions"))
+    builder.Connect(supervisor.GetOutputPort("plan_request"), planner.GetInputPort("plan_request"))
 
     ports = {"scene_description": scene,
              "category_prior": prior.GetOutputPort("category_prior"),
              "grasp_semantics": logic.GetOutputPort("grasp_semantics"),
              "ranked_grasps": scoring.GetOutputPort("ranked_grasps"),
              "plan_status": planner.GetOutputPort("plan_status"),
-             "collisions": planner.GetOutputPort("collisions")}
+             "collisions": supervisor.GetOutputPort("collisions"),
+             "plan_request": supervisor.GetOutputPort("plan_request"),
+             "outcome": supervisor.GetOutputPort("outcome")}
     return Pipeline(station=station, perception=perception, target=target, prior=prior,
-                    logic=logic, scoring=scoring, planner=planner, task=task, config=config,
-                    ports=ports)
+                    logic=logic, scoring=scoring, planner=planner, supervisor=supervisor,
+                    task=task, config=config, ports=ports)

@@ -1,7 +1,12 @@
-"""What physically happened to the target object: grasped, lifted, placed — read off the plant.
+"""What physically happened to the target object: grasped, lifted, placed — read off port values.
 
-These checks read the simulated state (poses, finger positions, hydroelastic contact surfaces); they
-are the ground truth of an execution, never inputs to the pipeline's decisions.
+These checks take what the plant's output ports give (``contact_results``: a `ContactResults`;
+``body_poses``: world poses; ``wsg.state``: the finger positions) and the geometry ids of the
+bodies involved (`HandGeometries`, read once from the finalized plant's model). They are the
+ground truth of an execution, never inputs to the pipeline's perception or reasoning.
+
+The one rule for "held" is `is_held`: both finger pads touch the object and the fingers stand more
+than `CLOSED_ON_AIR` apart.
 """
 
 from __future__ import annotations
@@ -23,6 +28,33 @@ PLACE_XY_TOLERANCE = 0.05
 PLACE_TILT_TOLERANCE = np.deg2rad(20)
 
 
+def is_held(touches_left: bool, touches_right: bool, opening: float) -> bool:
+    """The one rule for "the gripper holds the object": both pads touch it and the fingers are
+    more than `CLOSED_ON_AIR` apart (`opening` [m], between the pads' inner faces)."""
+    return bool(touches_left and touches_right and opening > CLOSED_ON_AIR)
+
+
+@dataclass(frozen=True)
+class HandGeometries:
+    """Collision geometry ids of the target object, the two WSG fingers and the table."""
+
+    object: frozenset
+    left: frozenset
+    right: frozenset
+    table: frozenset
+
+    @classmethod
+    def from_plant(cls, plant, *, object_body, wsg_instance, table_instance) -> "HandGeometries":
+        """Reads the ids from a finalized plant's model (no context needed)."""
+        def of(body):
+            return frozenset(plant.GetCollisionGeometriesForBody(body))
+        table = frozenset(g for b in plant.GetBodyIndices(table_instance)
+                          for g in plant.GetCollisionGeometriesForBody(plant.get_body(b)))
+        return cls(object=of(object_body),
+                   left=of(plant.GetBodyByName("left_finger", wsg_instance)),
+                   right=of(plant.GetBodyByName("right_finger", wsg_instance)), table=table)
+
+
 @dataclass
 class HandContact:
     opening: float  # [m] distance between the finger pads' inner faces
@@ -32,51 +64,45 @@ class HandContact:
 
     @property
     def held(self) -> bool:
-        return self.left and self.right and self.opening > CLOSED_ON_AIR
+        return is_held(self.left, self.right, self.opening)
 
 
-def hand_contact(plant, plant_context, *, object_body, wsg_instance) -> HandContact:
-    """Which finger pads touch the object, from the plant's contact results."""
-    q = plant.GetPositions(plant_context, wsg_instance)
-    results = plant.get_contact_results_output_port().Eval(plant_context)
-    object_geometries = set(plant.GetCollisionGeometriesForBody(object_body))
-    left = set(plant.GetCollisionGeometriesForBody(
-        plant.GetBodyByName("left_finger", wsg_instance)))
-    right = set(plant.GetCollisionGeometriesForBody(
-        plant.GetBodyByName("right_finger", wsg_instance)))
-    touches_left = touches_right = False
-    surfaces = 0
+def contact_pairs(contact_results) -> list[tuple]:
+    """(GeometryId, GeometryId) of every hydroelastic surface and point pair in `contact_results`
+    (the plant's ``contact_results`` output)."""
     pairs = []
-    for i in range(results.num_hydroelastic_contacts()):
-        s = results.hydroelastic_contact_info(i).contact_surface()
+    for i in range(contact_results.num_hydroelastic_contacts()):
+        s = contact_results.hydroelastic_contact_info(i).contact_surface()
         pairs.append((s.id_M(), s.id_N()))
-        if s.id_M() in object_geometries or s.id_N() in object_geometries:
-            surfaces += 1
-    for i in range(results.num_point_pair_contacts()):
-        info = results.point_pair_contact_info(i).point_pair()
+    for i in range(contact_results.num_point_pair_contacts()):
+        info = contact_results.point_pair_contact_info(i).point_pair()
         pairs.append((info.id_A, info.id_B))
-    for a, b in pairs:
-        other = b if a in object_geometries else a if b in object_geometries else None
+    return pairs
+
+
+def hand_contact(contact_results, *, wsg_q, geometries: HandGeometries) -> HandContact:
+    """Which finger pads touch the object; `wsg_q` = (q_left, q_right) [m], the first two entries
+    of the station's ``wsg.state``."""
+    touches_left = touches_right = False
+    obj = geometries.object
+    surfaces = sum(1 for i in range(contact_results.num_hydroelastic_contacts())
+                   if {contact_results.hydroelastic_contact_info(i).contact_surface().id_M(),
+                       contact_results.hydroelastic_contact_info(i).contact_surface().id_N()}
+                   & obj)
+    for a, b in contact_pairs(contact_results):
+        other = b if a in obj else a if b in obj else None
         if other is None:
             continue
-        touches_left |= other in left
-        touches_right |= other in right
-    return HandContact(float(q[1] - q[0]), touches_left, touches_right, surfaces)
+        touches_left |= other in geometries.left
+        touches_right |= other in geometries.right
+    return HandContact(float(wsg_q[1] - wsg_q[0]), touches_left, touches_right, surfaces)
 
 
-def touches_table(plant, plant_context, *, object_body, table_instance) -> bool:
-    """Does the object touch the table top (any hydroelastic surface or point pair)?"""
-    results = plant.get_contact_results_output_port().Eval(plant_context)
-    obj = set(plant.GetCollisionGeometriesForBody(object_body))
-    table = {g for b in plant.GetBodyIndices(table_instance)
-             for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))}
-    pairs = [(results.hydroelastic_contact_info(i).contact_surface().id_M(),
-              results.hydroelastic_contact_info(i).contact_surface().id_N())
-             for i in range(results.num_hydroelastic_contacts())]
-    pairs += [(results.point_pair_contact_info(i).point_pair().id_A,
-               results.point_pair_contact_info(i).point_pair().id_B)
-              for i in range(results.num_point_pair_contacts())]
-    return any((a in obj and b in table) or (b in obj and a in table) for a, b in pairs)
+def touches_table(contact_results, *, geometries: HandGeometries) -> bool:
+    """Does the object touch the table (any hydroelastic surface or point pair)?"""
+    obj, table = geometries.object, geometries.table
+    return any((a in obj and b in table) or (b in obj and a in table)
+               for a, b in contact_pairs(contact_results))
 
 
 def placed(X_WO_picked, X_WO_now, p_W_target_xy, *, released: bool,

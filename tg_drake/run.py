@@ -1,8 +1,16 @@
 """`tg-drake run SCENARIO [--out DIR] [--meshcat]`: the whole pipeline in simulation.
 
-perception → kernel prior → logic → DGI scoring → planning → execution, in one diagram
-(`tg_drake.diagram.add_pipeline`). Prints a one-screen summary; writes `result.json` (keys in
-DESIGN.md) and pictures: the camera view, the part-coloured perceived cloud, the chosen grasp.
+A straight builder script in the shape of Drake's hardware_sim: load the scenario → `add_pipeline`
+(station, every stage and the `Supervisor`) → build → `ApplySimulatorConfig` → randomise the context
+from `random_seed` → advance until the supervisor's outcome is final or `simulation_duration` has
+passed (outcome failed, "timeout") → write `result.json`, then the pictures (`tg_drake.report`).
+
+result.json holds: `scenario`, `task_given`, `perception` (`pose`, `parts`, ...), `category_prior`,
+`category`, `task`, `part` (each a distribution: name → probability), `collisions` (the parts given
+to the logic as collision evidence), `explanations`, `grasp_probability`, `n_hypotheses`,
+`planning`, `grasp` (`xyz`, `rpy`, `part`, `p_part`, `p_local`, `score`), `outcome` (`status`: one
+of `OUTCOME_STATUSES`; `reason`: one of `FAILURE_REASONS` or ""; `detail`; the closed loop's
+parts and re-queries), `timings` (seconds) and `config` (the full resolved scenario).
 
 A run never ends in a traceback for a failure of the task itself: an object out of reach, nothing
 perceived at the target, every grasp ruled out by the logic, a diverging simulation — each is an
@@ -11,50 +19,19 @@ outcome with status "failed" and its reason.
 
 from __future__ import annotations
 
-import json
+import dataclasses
 import time
-from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-import numpy as np
+from tg_drake.errors import TgDrakeError
+from tg_drake.types import THEORY_VARIANTS
 
-from tg_drake.logic.theory import VARIANTS as THEORY_VARIANTS
-from tg_drake import robot
-from tg_drake.bench import Figure
-from tg_drake.errors import (GraspingError, KernelError, PerceptionError, PlanningError,
-                             RuleError, SimulationError, TgDrakeError)
-from tg_drake.objects import box_centre
-from tg_drake.outcome import hand_contact, placed, touches_table
-from tg_drake.types import PART_COLORS
+# Start-up: `tg-drake --help` imports this module, so pydrake, the diagram, the report and the
+# supervisor (all importing pydrake) are imported inside the functions that use them.
 
-# Start-up: `tg-drake --help` imports this module, so pydrake, the diagram, the scenario schema
-# (pydrake) and matplotlib are imported inside the functions that use them.
+__all__ = ["run", "run_scenario"]
 
 HELP = "run the whole pipeline on a scenario: perceive, reason, score, plan, grasp, place"
-
-OUTCOME_STATUSES = ("placed", "lifted", "grasped", "failed")
-FAILURE_REASONS = ("unreachable", "perception", "logic", "slipped", "missed", "collision",
-                   "simulation", "timeout")
-
-
-# The failure reason a stage's error stands for.
-REASON_OF_ERROR = ((PerceptionError, "perception"), (KernelError, "perception"),
-                   (RuleError, "logic"), (GraspingError, "logic"),
-                   (PlanningError, "unreachable"), (SimulationError, "simulation"))
-
-
-def reason_of(error: TgDrakeError) -> str:
-    return next((r for cls, r in REASON_OF_ERROR if isinstance(error, cls)), "simulation")
-
-
-@dataclass
-class Outcome:
-    status: str  # one of OUTCOME_STATUSES
-    reason: str = ""  # for "failed" (one of FAILURE_REASONS) or partial success; "" when placed
-    detail: str = ""  # a human-readable explanation
-    reachable_parts: list = field(default_factory=list)
-    unreachable_parts: list = field(default_factory=list)
-    requeries: int = 0
 
 
 def add_arguments(parser) -> None:
@@ -70,179 +47,59 @@ def add_arguments(parser) -> None:
                         "pipeline.logic.category and pipeline.logic.grasp")
 
 
-def _distribution(d: dict) -> dict:
-    return {k: round(float(v), 6) for k, v in sorted(d.items(), key=lambda kv: -kv[1])}
-
-
-def _xyz_rpy(X) -> dict:
-    from pydrake.math import RigidTransform, RollPitchYaw
-    X = X if isinstance(X, RigidTransform) else RigidTransform(np.asarray(X))
-    return {"xyz": [round(float(v), 5) for v in X.translation()],
-            "rpy": [round(float(v), 5) for v in RollPitchYaw(X.rotation()).vector()]}
-
-
-def run_scenario(scenario, *, scenario_path: str = "", meshcat=None, images_dir: Path | None = None
-                 ) -> dict:
-    """Runs one scenario end to end and returns the result dictionary (result.json)."""
-    from pydrake.systems.analysis import Simulator
-    from pydrake.systems.framework import DiagramBuilder
+def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
+        ) -> tuple[dict, object]:
+    """Runs one scenario end to end: the result dictionary (result.json) and what the pictures
+    are drawn from."""
+    from pydrake.common import RandomGenerator
+    from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
+    from pydrake.systems.framework import DiagramBuilder, EventStatus
 
     from tg_drake.diagram import add_pipeline
+    from tg_drake.report import Pictures, Stages, evaluate_stages, final_stages, result_of
+    from tg_drake.systems.supervisor import Outcome, Reason, Status, outcome_of_error
 
     timings: dict[str, float] = {}
     t_start = time.perf_counter()
+    # The station and every stage, the supervisor included; Meshcat if asked for.
     builder = DiagramBuilder()
     pipeline = add_pipeline(builder, scenario=scenario)
-    station = pipeline.station
     visualizer = None
     if meshcat is not None:
         from pydrake.geometry import MeshcatVisualizer
-        visualizer = MeshcatVisualizer.AddToBuilder(builder, station.scene_graph, meshcat)
+        visualizer = MeshcatVisualizer.AddToBuilder(builder, pipeline.station.scene_graph,
+                                                    meshcat)
     diagram = builder.Build()
+
+    # The simulator as the scenario configures it; the context drawn from its seed.
     simulator = Simulator(diagram)
+    ApplySimulatorConfig(scenario.simulator_config, simulator)
     context = simulator.get_mutable_context()
+    diagram.SetRandomContext(context, RandomGenerator(scenario.random_seed))
     timings["build"] = time.perf_counter() - t_start
 
-    result: dict = {"scenario": scenario_path, "task_given": scenario.task.task or None,
-                    "perception": {"n_objects": 0, "target": None}}
+    # Stop as soon as the supervisor's outcome is final.
+    outcome_port = pipeline.ports["outcome"]
+    supervisor = pipeline.supervisor
 
-    # The stages at t = 0, each timed on its own (their values stay cached for the planner).
-    def timed(name, port):
-        t0 = time.perf_counter()
-        value = port.Eval(port.get_system().GetMyContextFromRoot(context))
-        timings[name] = time.perf_counter() - t0
-        return value
+    def outcome_now(root_context) -> Outcome:
+        return outcome_port.Eval(supervisor.GetMyContextFromRoot(root_context))
 
-    # The camera perception looks through (the first camera for ground-truth perception).
-    camera = getattr(pipeline.config.perception, "camera", next(iter(station.cameras), ""))
-    outcome = None
-    try:
-        if not pipeline.config.ground_truth_perception:
-            timed("render", station.outputs[f"{camera}.depth_image"])
-        scene = timed("perception", pipeline.ports["scene_description"])
-        result["perception"] = _perception_json(scene)
-        if not scene.objects:
-            outcome = Outcome("failed", "perception", "perception found no object on the table")
-        elif scene.target is None:
-            outcome = Outcome("failed", "perception",
-                              "perception found no object at the target's position")
-        if outcome is None:
-            prior = timed("kernel_prior", pipeline.ports["category_prior"])
-            result["category_prior"] = _distribution(prior.distributions[scene.target].as_dict())
-            semantics = timed("logic", pipeline.ports["grasp_semantics"])
-            result.update(_semantics_json(semantics))
-            result["grasp_probability"] = round(float(semantics.grasp_probability), 6)
-            if not semantics.part or max(semantics.part.values()) <= 0:
-                outcome = Outcome("failed", "logic", "the logic ruled every grasp out "
-                                  f"(task {scenario.task.task or 'inferred'})")
-            elif semantics.grasp_probability < pipeline.config.min_grasp_probability:
-                outcome = Outcome(
-                    "failed", "logic", "the logic rules grasping out: P(some part is grasped) = "
-                    f"{semantics.grasp_probability:.3f} < {pipeline.config.min_grasp_probability}"
-                    f" (task {scenario.task.task or 'inferred'})")
-        if outcome is None:
-            ranked = timed("dgi_scoring", pipeline.ports["ranked_grasps"])
-            result["n_hypotheses"] = int(len(ranked.score))
-            if len(ranked.score) == 0 or not np.any(ranked.score > 0):
-                outcome = Outcome("failed", "logic", "no pre-grasp hypothesis with a non-zero score")
-    except TgDrakeError as e:
-        outcome = Outcome("failed", reason_of(e), str(e))
+    simulator.set_monitor(lambda root: EventStatus.ReachedTermination(supervisor, "outcome final")
+                          if outcome_now(root).final else EventStatus.DidNothing())
 
-    if images_dir is not None and "perception" in result:
-        _write_images(images_dir, station, context, pipeline, camera)
-
-    if outcome is None:
-        outcome = _execute(simulator, pipeline, scenario, result, timings, visualizer)
-    result["outcome"] = asdict(outcome)
-    X_WG = result.pop("grasp_X_WG", None)
-    if images_dir is not None and X_WG is not None:
-        save_grasp_png(scene.objects[scene.target], X_WG, images_dir / "grasp.png",
-                       title=_grasp_title(result))
-    timings["total"] = time.perf_counter() - t_start
-    result["timings"] = {k: round(v, 4) for k, v in timings.items()}
-    return result
-
-
-def _execute(simulator, pipeline, scenario, result, timings, visualizer) -> Outcome:
-    """Simulates planning and execution; reads off what physically happened."""
-    context = simulator.get_mutable_context()
-    station = pipeline.station
-    plant = station.plant
-    plant_context = plant.GetMyMutableContextFromRoot(context)
-    status_port = pipeline.ports["plan_status"]
-    planner_context = pipeline.planner.GetMyContextFromRoot(context)
-    target_name = scenario.target_placement().instance_name
-    body = station.object_body(target_name)
-    wsg = station.instances["wsg"]
     if visualizer is not None:
         visualizer.StartRecording()
+    stages = None
+    error = None
     t_sim = time.perf_counter()
     try:
         simulator.Initialize()
-        # Planning: events every period until the planner executes or gives up.
-        deadline = pipeline.config.planning_start + 2.0
-        status = status_port.Eval(planner_context)
-        while status.status == "planning" and context.get_time() < deadline:
-            simulator.AdvanceTo(context.get_time() + 0.05)
-            status = status_port.Eval(planner_context)
-        timings["planning"] = status.planning_time
-        result["planning"] = {"status": status.status, "part": status.part,
-                              "unreachable_parts": list(status.unreachable_parts),
-                              "requeries": status.requeries, "reason": status.reason}
-        if status.status != "executing":
-            reason = "unreachable" if status.status == "unreachable" else "timeout"
-            return Outcome("failed", reason, status.reason or "planning did not finish",
-                           unreachable_parts=list(status.unreachable_parts),
-                           requeries=status.requeries)
-        ranked = pipeline.ports["ranked_grasps"].Eval(
-            pipeline.scoring.GetMyContextFromRoot(context))
-        i = status.candidate
-        result["grasp_X_WG"] = np.asarray(status.X_WG, float)  # for the picture; not in JSON
-        result["grasp"] = {**_xyz_rpy(status.X_WG), "part": status.part,
-                           "p_part": float(ranked.p_part[i]) if i is not None else None,
-                           "p_local": float(ranked.p_local[i]) if i is not None else None,
-                           "score": float(ranked.score[i]) if i is not None else None}
-        plan = status.plan
-        t0 = status.t_plan
-        X_WO_picked = body.EvalPoseInWorld(plant_context)
-        common = dict(unreachable_parts=list(status.unreachable_parts),
-                      requeries=status.requeries)
-
-        simulator.AdvanceTo(t0 + plan.t_grasp_closed)
-        grasp = hand_contact(plant, plant_context, object_body=body, wsg_instance=wsg)
-        if not grasp.held:
-            return Outcome("failed", "missed", f"fingers closed to {grasp.opening * 1000:.0f} mm "
-                           f"without holding the object (left pad {grasp.left}, right pad "
-                           f"{grasp.right})", **common)
-        G = plant.GetFrameByName("body", wsg)
-        z_G_grasped = G.CalcPoseInWorld(plant_context).translation()[2]
-        z_O_grasped = body.EvalPoseInWorld(plant_context).translation()[2]
-        simulator.AdvanceTo(t0 + plan.t_lift_done)
-        lift = hand_contact(plant, plant_context, object_body=body, wsg_instance=wsg)
-        rise = body.EvalPoseInWorld(plant_context).translation()[2] - z_O_grasped
-        gripper_rise = G.CalcPoseInWorld(plant_context).translation()[2] - z_G_grasped
-        if not lift.held or rise < 0.5 * gripper_rise:
-            return Outcome("grasped", "slipped", f"the object rose {rise * 100:.1f} cm while the "
-                           f"gripper rose {gripper_rise * 100:.1f} cm", **common)
-        simulator.AdvanceTo(t0 + plan.duration)
-        X_WO_now = body.EvalPoseInWorld(plant_context)
-        if not np.all(np.isfinite(X_WO_now.GetAsMatrix4())):
-            return Outcome("failed", "simulation", "the simulation diverged", **common)
-        # Let go: the gripper has opened and the table carries the object (a pad may still
-        # brush it after opening).
-        release = hand_contact(plant, plant_context, object_body=body, wsg_instance=wsg)
-        on_table = touches_table(plant, plant_context, object_body=body,
-                                 table_instance=station.instances["table"])
-        ok, detail = placed(X_WO_picked, X_WO_now, plan.X_WO_place[:2, 3],
-                            released=on_table and not release.held,
-                            p_OC=box_centre(scenario.target_placement().id))
-        if ok:
-            return Outcome("placed", "", detail, **common)
-        return Outcome("lifted", "slipped", detail, **common)
-    except TgDrakeError as e:  # a stage failed while the planner re-queried it
-        return Outcome("failed", reason_of(e), str(e))
-    except RuntimeError as e:
-        return Outcome("failed", "simulation", f"the simulation failed: {e}")
+        stages = evaluate_stages(pipeline, context, timings, rgb=images)
+        t_sim = time.perf_counter()
+        simulator.AdvanceTo(scenario.simulation_duration)
+    except (TgDrakeError, RuntimeError) as e:  # a stage failed, or the simulation did
+        error = e
     finally:
         timings["simulation"] = time.perf_counter() - t_sim
         timings["simulated_time"] = context.get_time()
@@ -250,145 +107,45 @@ def _execute(simulator, pipeline, scenario, result, timings, visualizer) -> Outc
             visualizer.StopRecording()
             visualizer.PublishRecording()
 
-
-def _perception_json(scene) -> dict:
-    if scene.target is None:
-        return {"n_objects": len(scene.objects), "target": None}
-    obj = scene.objects[scene.target]
-    return {"n_objects": len(scene.objects), "target": scene.target, "pose": obj.pose,
-            "pose_likelihood": _distribution(obj.pose_likelihood),
-            "parts": _distribution(obj.part_probabilities),
-            "extents": [round(float(v), 4) for v in obj.extents],
-            "n_points": int(len(obj.p_W))}
-
-
-def _semantics_json(semantics) -> dict:
-    out = {"category": _distribution(semantics.category), "task": _distribution(semantics.task),
-           "part": _distribution(semantics.part), "collisions": list(semantics.collisions)}
-    out["explanations"] = {
-        query: [{"answer": e.answer, "probability": round(float(e.probability), 6),
-                 "reasons": [[r, round(float(w), 6)] for r, w in e.reasons[:5]]}
-                for e in explanations]
-        for query, explanations in semantics.explanations.items()}
-    return out
+    # The outcome: the supervisor's, or the error's, or a timeout.
+    outcome = outcome_now(context)
+    if error is not None:
+        outcome = outcome_of_error(error, pending=outcome)
+    elif not outcome.final:
+        outcome = dataclasses.replace(
+            outcome, status=Status.failed, reason=Reason.timeout,
+            detail=f"not finished within simulation_duration = {scenario.simulation_duration} s "
+            f"({outcome.detail})")
+    plan_status = pipeline.ports["plan_status"].Eval(
+        pipeline.planner.GetMyContextFromRoot(context))
+    stages = final_stages(pipeline, context, stages, outcome) if stages else Stages()
+    timings["total"] = time.perf_counter() - t_start
+    result = result_of(scenario=scenario, scenario_path=scenario_path, stages=stages,
+                       outcome=outcome, plan_status=plan_status, timings=timings)
+    return result, Pictures(stages, X_WG=plan_status.X_WG)
 
 
-def _write_images(folder: Path, station, context, pipeline, camera) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    folder.mkdir(parents=True, exist_ok=True)
-    if camera in station.cameras:
-        rgb = station.outputs[f"{camera}.rgb_image"].Eval(
-            station.cameras[camera].sensor.GetMyContextFromRoot(context))
-        plt.imsave(folder / "camera.png", np.array(rgb.data[:, :, :3]))
-    scene = pipeline.ports["scene_description"].Eval(
-        pipeline.target.GetMyContextFromRoot(context))
-    from tg_drake.perception.plot import save_scene_png
-    save_scene_png(scene.objects, folder / "parts.png")
-
-
-# The open WSG's finger pads in G and its body box, for the grasp picture (tg_drake.robot).
-_PADS_G = robot.wsg_pad_boxes()
-_BODY_G = (robot.WSG_BODY_CENTRE_G, robot.WSG_BODY_SIZE)
-
-
-def _box_edges(X_WG: np.ndarray, centre, size) -> list[np.ndarray]:
-    """The 12 edges of a box given in G, as (2, 3) world segments."""
-    c, h = np.asarray(centre), np.asarray(size) / 2
-    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * h + c
-    corners_W = corners @ X_WG[:3, :3].T + X_WG[:3, 3]
-    return [corners_W[[i, j]] for i in range(8) for j in range(i + 1, 8)
-            if np.sum(np.abs(np.sign(corners[i] - c) - np.sign(corners[j] - c))) == 2]
-
-
-def save_grasp_png(obj, X_WG: np.ndarray, path: Path, *, title: str = "") -> Path:
-    """The target's part-coloured cloud in the world with the chosen gripper pose drawn as boxes
-    (finger pads black, body grey) and its approach direction."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig = plt.figure(figsize=(5, 5))
-    ax = fig.add_subplot(projection="3d")
-    idx = np.random.default_rng(0).permutation(len(obj.p_W))[:5000]
-    ax.scatter(*obj.p_W[idx].T, c=np.asarray(PART_COLORS)[obj.labels[idx]], s=2,
-               depthshade=False, linewidths=0)
-    for centre, size in _PADS_G:
-        for e in _box_edges(X_WG, centre, size):
-            ax.plot(*e.T, color="black", linewidth=1.2)
-    for e in _box_edges(X_WG, *_BODY_G):
-        ax.plot(*e.T, color="0.5", linewidth=0.8)
-    grasp_point = X_WG[:3, 3] + X_WG[:3, :3] @ robot.WSG_GRASP_POINT_G
-    ax.quiver(*(grasp_point - 0.12 * X_WG[:3, 1]), *(0.08 * X_WG[:3, 1]), color="black")
-    centre = obj.X_WO[:3, 3]
-    half = max(0.5 * float(np.max(obj.extents)), 0.12)
-    ax.set_xlim(centre[0] - half, centre[0] + half)
-    ax.set_ylim(centre[1] - half, centre[1] + half)
-    ax.set_zlim(max(centre[2] - half, -0.01), centre[2] + 2 * half)
-    ax.set_box_aspect((1, 1, 1.5))
-    ax.set_xlabel("x_W [m]")
-    ax.set_ylabel("y_W [m]")
-    ax.set_zlabel("z_W [m]")
-    ax.set_title(title, fontsize=8)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
-
-
-def _grasp_title(result: dict) -> str:
-    g = result["grasp"]
-    return (f"grasp on {g['part']}: score {g['score']:.2f} = P(part|task) {g['p_part']:.2f} × "
-            f"P(grasp|shape) {g['p_local']:.2f}\noutcome: {result['outcome']['status']}")
-
-
-def summary(result: dict) -> str:
-    """The one-screen summary printed after a run."""
-    def top(d, n=4):
-        return ", ".join(f"{k} {v:.2f}" for k, v in list(d.items())[:n]) if d else "-"
-    o = result["outcome"]
-    lines = [f"scenario   {result['scenario']}"]
-    if "perception" in result and result["perception"].get("pose"):
-        p = result["perception"]
-        lines.append(f"perceived  {p['n_objects']} object(s); target pose {p['pose']}, parts "
-                     f"{top(p['parts'], 5)}")
-    for key in ("category_prior", "category", "task", "part"):
-        if key in result:
-            lines.append(f"{key:<10} {top(result[key])}")
-    if "grasp" in result:
-        g = result["grasp"]
-        lines.append(f"grasp      part {g['part']}, xyz {g['xyz']}, score {g['score']:.3f} "
-                     f"(P(part|task) {g['p_part']:.2f} × P(grasp|shape) {g['p_local']:.2f})")
-    status = o["status"] + (f" ({o['reason']})" if o["reason"] else "")
-    lines.append(f"outcome    {status}: {o['detail']}")
-    if o["unreachable_parts"]:
-        lines.append(f"closed loop: unreachable parts {o['unreachable_parts']} became "
-                     f"collision evidence; {o['requeries']} re-quer{'y' if o['requeries'] == 1 else 'ies'}")
-    t = result["timings"]
-    lines.append("timings    " + ", ".join(f"{k} {v:.2f}s" for k, v in t.items()
-                                          if k != "simulated_time"))
-    return "\n".join(lines)
+def run_scenario(scenario, *, scenario_path: str = "", meshcat=None) -> dict:
+    """Runs one scenario end to end and returns the result dictionary (result.json)."""
+    return run(scenario, scenario_path=scenario_path, meshcat=meshcat)[0]
 
 
 def main(args) -> int:
+    from tg_drake.report import summary, write
     from tg_drake.scenario import load_scenario
 
     scenario = load_scenario(args.scenario, scenario_name=args.name)
     if getattr(args, "theory", None):
         scenario.pipeline.logic.category = scenario.pipeline.logic.grasp = args.theory
     out = args.out or Path("out") / (args.name or args.scenario.stem)
-    out.mkdir(parents=True, exist_ok=True)
     meshcat = None
     if args.meshcat:
         from pydrake.geometry import StartMeshcat
         meshcat = StartMeshcat()
         print(f"Meshcat: {meshcat.web_url()}")
-    result = run_scenario(scenario, scenario_path=str(args.scenario), meshcat=meshcat,
-                          images_dir=None if args.no_images else out)
-    (out / "result.json").write_text(json.dumps(result, indent=2) + "\n")
+    result, pictures = run(scenario, scenario_path=str(args.scenario), meshcat=meshcat,
+                           images=not args.no_images)
+    write(out, result, None if args.no_images else pictures)
     print(summary(result))
     print(f"wrote {out}/result.json")
     if meshcat is not None:
@@ -407,6 +164,7 @@ def bench_pipeline_rtf():
     the one-off diagram build is not counted), median of 3 runs. The reference is the same run with
     Drake's explicit inverse-dynamics arm controller at a 2 ms step (one run); `speedup` = ours /
     reference (a rate: higher is better)."""
+    from tg_drake.bench import Figure
     from tg_drake.scenario import InverseDynamicsDriver, ObjectPlacement, Scenario, TaskConfig
 
     def rate(explicit: bool) -> float:

@@ -37,7 +37,7 @@ from tg_drake.logic.engine import LogicQueryConfig
 from tg_drake.objects import get_object, mesh
 from tg_drake.perception.config import PerceptionConfig
 from tg_drake.planning.planner import PlannerConfig
-from tg_drake.robot import IIWA_HOME, WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
+from tg_drake.robot import WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
 from tg_drake.robot_plants import default_directives
 from tg_drake.schema_check import SchemaError, check_document, load_raw
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, table_size_problem
@@ -213,6 +213,35 @@ ScoringVariant = typing.Union[DgiScorer, LocalOnly, OnePart]
 SELECTION_OF_SCORING = {DgiScorer: "pipeline", LocalOnly: "local_only", OnePart: "one_part"}
 
 
+@dataclass
+class SupervisorConfig:
+    """The closed loop's policy. Lives in the scenario's `pipeline.supervisor` block."""
+
+    min_grasp_probability: float = 0.03  # [probability] below this P(some part is grasped |
+    # observations) the logic is taken to rule grasping out (an upside-down pan: 0.015; the
+    # paper's Fig. 1 cup: 0.13)
+    max_requeries: int = 3  # re-queries of the logic with collision(Part) evidence
+    planning_start: float = 0.05  # [s] simulated time of the first gate check
+    planning_timeout: float = 2.0  # [s] simulated time after planning_start by which a plan
+    # must exist (planning takes no simulated time; each attempt waits for a planning event)
+    period: float = 0.005  # [s] spacing of the supervisor's checks (a monitor check happens at
+    # the first check at or after the plan's key time)
+    min_rise_ratio: float = 0.5  # [1] during the lift the object must rise at least this share
+    # of the gripper's rise, else it slipped
+
+    def validate(self, where: str = "pipeline.supervisor") -> None:
+        checks = (("min_grasp_probability", 0.0 <= self.min_grasp_probability <= 1.0, "in [0, 1]"),
+                  ("max_requeries", self.max_requeries >= 0, ">= 0"),
+                  ("planning_start", self.planning_start >= 0.0, ">= 0 s"),
+                  ("planning_timeout", self.planning_timeout > 0.0, "> 0 s"),
+                  ("period", self.period > 0.0, "> 0 s"),
+                  ("min_rise_ratio", 0.0 <= self.min_rise_ratio <= 1.0, "in [0, 1]"))
+        for name, ok, allowed in checks:
+            if not ok:
+                raise ScenarioError(f"must be {allowed}, got {getattr(self, name)}",
+                                    field=f"{where}.{name}")
+
+
 def _pipeline_logic() -> LogicQueryConfig:
     # The logic sees (1 − floor)·prior + floor/11: a perceived object's kernel prior can miss its
     # category, and a zero there would make the evidence impossible.
@@ -229,10 +258,8 @@ class PipelineConfig:
     logic: LogicQueryConfig = field(default_factory=_pipeline_logic)  # theory variants, prior use
     scoring: ScoringVariant = field(default_factory=DgiScorer)  # how hypotheses are ranked
     planner: PlannerConfig = field(default_factory=PlannerConfig)  # the pick-and-place plan
-    planning_start: float = 0.05  # [s] simulated time of the first planning event
-    max_requeries: int = 3  # re-queries of the logic with collision(Part) evidence
-    min_grasp_probability: float = 0.03  # below this P(some part is grasped | observations), the
-    # logic is taken to rule grasping out (an upside-down pan: 0.015; the paper's Fig. 1 cup: 0.13)
+    supervisor: SupervisorConfig = field(default_factory=SupervisorConfig)  # the closed loop:
+    # gate, re-queries, waiting for plans, execution monitor
 
     def validate(self, where: str = "pipeline") -> None:
         """Checks names the YAML types cannot; raises ScenarioError naming the field."""
@@ -258,6 +285,7 @@ class PipelineConfig:
         if self.scoring.model and not Path(self.scoring.model).is_file():
             raise ScenarioError(f"no such DGI model file {self.scoring.model!r}",
                                 field=f"{where}.scoring.model")
+        self.supervisor.validate(f"{where}.supervisor")
 
     @property
     def ground_truth_perception(self) -> bool:
@@ -528,13 +556,6 @@ def _validate_simulation(scenario: Scenario) -> None:
               allow_zero=True)
     if sim.use_error_control:
         _positive(sim.accuracy, "simulator_config.accuracy", "1")
-    p = scenario.pipeline
-    for name in ("max_requeries",):
-        if getattr(p, name, 0) < 0:
-            raise ScenarioError(f"must be ≥ 0, got {getattr(p, name)}", field=f"pipeline.{name}")
-    if hasattr(p, "min_grasp_probability") and not 0 <= p.min_grasp_probability <= 1:
-        raise ScenarioError(f"a probability must be in [0, 1], got {p.min_grasp_probability}",
-                            field="pipeline.min_grasp_probability")
 
 
 # Two objects whose shapes overlap deeper than this interpenetrate [m]: the library's meshes are

@@ -28,10 +28,10 @@ from __future__ import annotations
 
 import copy
 import functools
-import importlib.resources
 from dataclasses import dataclass, field
 
 import numpy as np
+from pydrake.common.value import AbstractValue
 from pydrake.geometry import MakeRenderEngineGl, RenderEngineGlParams, SceneGraph, kHasRenderEngineGl
 from pydrake.lcm import DrakeLcm
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix

@@ -27,6 +27,11 @@ CATEGORIES: tuple[str, ...] = (
 )
 
 # The paper's 7 tasks (section IV-B). Names as in the paper; the ProbLog theory maps them to atoms.
+# Variants of the ProbLog theory's category and grasp models (paper IV-C: specific, general;
+# "learned": the probabilities fitted to simulated grasps, tg_drake/logic/learning.py and
+# tools/learn_theory.py, in rules/category_learned.pl and rules/grasp_learned.pl).
+THEORY_VARIANTS: tuple[str, ...] = ("specific", "general", "learned")
+
 TASKS: tuple[str, ...] = (
     "pass", "pourOut", "pourIn", "p&pInUpright", "p&pInUpsidedown", "p&pInSideways", "p&pOn",
 )

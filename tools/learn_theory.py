@@ -111,6 +111,7 @@ def _scenario(spec: dict, *, task: str, grasp_part: str | None = None, theory: s
         OnePart,
         PipelineConfig,
         Scenario,
+        SupervisorConfig,
         TaskConfig,
         validate,
     )
@@ -121,7 +122,8 @@ def _scenario(spec: dict, *, task: str, grasp_part: str | None = None, theory: s
         task=TaskConfig(task=task, place_xy=PLACE_XY),
         pipeline=PipelineConfig(perception=GroundTruthPerception(),
                                 scoring=OnePart(part=grasp_part) if grasp_part else DgiScorer(),
-                                min_grasp_probability=0.0 if grasp_part else 0.03))
+                                supervisor=SupervisorConfig(
+                                    min_grasp_probability=0.0 if grasp_part else 0.03)))
     scenario.pipeline.logic.category = scenario.pipeline.logic.grasp = theory
     validate(scenario, where=spec["name"])
     return scenario

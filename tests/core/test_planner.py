@@ -12,7 +12,7 @@ from tg_drake.planning.ik import (CONSTRAINT_TOLERANCE, clearance, make_arm_plan
                                   solve_ik_seeds)
 from tg_drake.planning.planner import PlannerConfig, place_pose, plan_pick_and_place
 from tg_drake.planning.trajectory import IIWA_VELOCITY_LIMITS
-from tg_drake.scenario import IIWA_HOME
+from tg_drake.robot import IIWA_HOME
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, PartBox
 
 # The IK tolerances of PlannerConfig: 2 mm per axis (so up to 2·√3 mm), 0.02 rad; plus what the

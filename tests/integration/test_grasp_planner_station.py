@@ -1,8 +1,10 @@
-"""GraspPlanner driving the simulated station: a library can is grasped, lifted and placed.
+"""GraspPlanner and Supervisor driving the simulated station: a library can is grasped, lifted and
+placed, and the supervisor's outcome (read from the plant's ports) says so.
 
-The scene description and the ranked grasps are fixed (as a perfect perception and scoring would
-give them); the leading part can only be grasped from under the table, so the run also goes once
-around the collision(Part) loop before the top grasp is planned and executed.
+The scene description, the logic's answer and the ranked grasps are fixed (as a perfect perception
+and scoring would give them); the leading part can only be grasped from under the table, so the
+run also goes once around the collision(Part) loop (the supervisor asks for a second attempt
+without it) before the top grasp is planned and executed.
 """
 
 from __future__ import annotations
@@ -20,12 +22,14 @@ from pydrake.systems.primitives import ConstantValueSource
 from tg_drake.objects import get_object
 from tg_drake.scenario import ObjectPlacement, Scenario
 from tg_drake.station import add_station, placement_pose
+from tg_drake.objects import box_centre
 from tg_drake.systems.grasp_planner import GraspPlanner
-from tg_drake.types import (PART_LABELS, GraspCandidates, ObjectDescription, PartBox,
-                            SceneDescription)
+from tg_drake.systems.supervisor import MonitorModel, Supervisor, SupervisorConfig
+from tg_drake.types import (PART_LABELS, GraspCandidates, GraspSemantics, ObjectDescription,
+                            PartBox, SceneDescription)
 
 PLACE_XY = (0.75, -0.25)  # [m] world
-START = 0.1  # [s] first planning event
+START = 0.1  # [s] the supervisor's first check
 OBJECT = "can_02"
 
 
@@ -62,25 +66,43 @@ def test_can_is_grasped_lifted_and_placed():
         parts=np.array([PART_LABELS.index("bottom"), PART_LABELS.index("top")]),
         p_part=np.array([0.6, 0.4]), p_local=np.array([0.9, 0.9]), score=np.array([0.54, 0.36]))
 
-    # Station, planner, and fixed perception/scoring outputs; the planner closes the arm loop.
+    meaning = GraspSemantics(category={"can": 1.0}, task={"p&pOn": 1.0},
+                             part={"bottom": 0.6, "top": 0.4}, given_task="p&pOn")
+
+    # Station, planner, supervisor, and fixed perception/logic/scoring outputs.
     builder = DiagramBuilder()
     station = add_station(builder, scenario=scenario)
-    planner = builder.AddSystem(GraspPlanner(place_xy=PLACE_XY, start_time=START))
+    config = SupervisorConfig(planning_start=START)
+    planner = builder.AddSystem(GraspPlanner(place_xy=PLACE_XY,
+                                             start_time=START + config.period))
+    plant = station.plant
+    supervisor = builder.AddSystem(Supervisor(config=config, model=MonitorModel.from_plant(
+        plant, object_body=station.object_body(OBJECT), wsg_instance=station.instances["wsg"],
+        table_instance=station.instances["table"], p_OC=box_centre(OBJECT))))
     scene_source = builder.AddSystem(ConstantValueSource(AbstractValue.Make(scene)))
     grasp_source = builder.AddSystem(ConstantValueSource(AbstractValue.Make(grasps)))
+    meaning_source = builder.AddSystem(ConstantValueSource(AbstractValue.Make(meaning)))
     builder.Connect(scene_source.get_output_port(), planner.get_scene_description_input_port())
     builder.Connect(grasp_source.get_output_port(), planner.get_ranked_grasps_input_port())
     builder.Connect(station.outputs["iiwa.state"], planner.get_iiwa_state_input_port())
     builder.Connect(planner.get_iiwa_desired_state_output_port(),
                     station.inputs["iiwa.desired_state"])
     builder.Connect(planner.get_wsg_position_output_port(), station.inputs["wsg.position"])
+    builder.Connect(supervisor.get_plan_request_output_port(),
+                    planner.get_plan_request_input_port())
+    builder.Connect(planner.get_plan_status_output_port(), supervisor.get_plan_status_input_port())
+    builder.Connect(scene_source.get_output_port(), supervisor.get_scene_description_input_port())
+    builder.Connect(grasp_source.get_output_port(), supervisor.get_ranked_grasps_input_port())
+    builder.Connect(meaning_source.get_output_port(), supervisor.get_grasp_semantics_input_port())
+    for name in ("wsg.state", "body_poses", "contact_results"):
+        builder.Connect(station.outputs[name], supervisor.GetInputPort(name))
     diagram = builder.Build()
 
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
-    plant = station.plant
     plant_context = plant.GetMyContextFromRoot(context)
     planner_context = planner.GetMyContextFromRoot(context)
+    supervisor_context = supervisor.GetMyContextFromRoot(context)
     body = station.object_body(OBJECT)
     wsg = station.instances["wsg"]
 
@@ -90,10 +112,14 @@ def test_can_is_grasped_lifted_and_placed():
 
     simulator.Initialize()
     wall = time.perf_counter()
-    simulator.AdvanceTo(START + 0.06)  # two planning events: the bottom fails, the top plans
+    # Checks at 0.1 (gate), 0.105 (the bottom fails), 0.11 (gate again); planning events at
+    # 0.105 (the bottom) and 0.155 (the top, without the bottom).
+    simulator.AdvanceTo(START + 0.06)
     status = planner.get_plan_status_output_port().Eval(planner_context)
-    assert (status.status, status.part, status.requeries) == ("executing", "top", 1)
-    assert status.unreachable_parts == ("bottom",)
+    assert (status.status, status.part, status.attempt) == ("executing", "top", 2)
+    outcome = supervisor.get_outcome_output_port().Eval(supervisor_context)
+    assert (outcome.final, outcome.unreachable_parts, outcome.requeries) == (
+        False, ("bottom",), 1)
     plan, t_plan = status.plan, status.t_plan
     p_WO_start = body.EvalPoseInWorld(plant_context).translation().copy()
 
@@ -119,5 +145,8 @@ def test_can_is_grasped_lifted_and_placed():
     assert np.linalg.norm(body.EvalSpatialVelocityInWorld(plant_context).translational()) < 1e-3
     assert opening() > 0.10  # released
     assert planner.get_plan_status_output_port().Eval(planner_context).status == "done"
+    # The supervisor, reading only ports, saw the same.
+    outcome = supervisor.get_outcome_output_port().Eval(supervisor_context)
+    assert (outcome.status, outcome.reason, outcome.reachable_parts) == ("placed", "", ("top",))
     print(f"\nplanning {status.planning_time:.2f} s (wall), plan {plan.duration:.2f} s, "
           f"simulated {simulator.get_context().get_time():.2f} s in {wall:.2f} s wall")

@@ -1,7 +1,7 @@
 """The whole pipeline on named scenarios: perceive, reason, score, plan, grasp, place.
 
-The default scenario runs in the default test run (about 15 s); the others are marked slow
-(`make test-slow`).
+The default scenario runs in the default test run (its run is shared with the other scenario
+tests); the others are marked slow (`make test-slow`).
 """
 
 import json
@@ -10,8 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tg_drake.run import FAILURE_REASONS, OUTCOME_STATUSES, run_scenario, summary
+from tg_drake.report import summary
+from tg_drake.run import run_scenario
 from tg_drake.scenario import load_scenario, look_at
+from tg_drake.systems.supervisor import FAILURE_REASONS, OUTCOME_STATUSES
 from tg_drake.types import CATEGORIES, PART_LABELS, POSES, TASKS
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -51,8 +53,8 @@ def check_result_keys(result: dict) -> None:
     assert all(v >= 0 for v in result["timings"].values())
 
 
-def test_default_scenario_passes_the_cup_by_its_middle():
-    result = run("default")
+def test_default_scenario_passes_the_cup_by_its_middle(cached_run):
+    result = cached_run(SCENARIOS / "default.yaml")
     check_result_keys(result)
     # The paper's Fig. 1 cup: cup is the most likely category, pass takes it by the middle.
     assert max(result["category"], key=result["category"].get) == "cup"
@@ -60,6 +62,12 @@ def test_default_scenario_passes_the_cup_by_its_middle():
     assert result["grasp"]["part"] == "middle"
     assert result["outcome"]["status"] == "placed", result["outcome"]
     assert "cup" in summary(result) and "placed" in summary(result)
+    # What the run used is what it reports: planning done, no collision evidence, and the full
+    # resolved configuration (the supervisor's settings included).
+    assert result["planning"]["status"] == "done"
+    assert result["collisions"] == result["outcome"]["unreachable_parts"] == []
+    assert result["config"]["pipeline"]["supervisor"]["max_requeries"] == 3
+    assert result["config"]["objects"][0]["id"] == "cup_01"
 
 
 @pytest.mark.slow
@@ -80,6 +88,7 @@ def test_object_out_of_reach_fails_as_unreachable():
     assert result["outcome"]["reason"] == "unreachable"
     # The closed loop asked the logic again with the unreachable parts as collision evidence.
     assert result["outcome"]["unreachable_parts"]
+    assert result["collisions"] == result["outcome"]["unreachable_parts"]
 
 
 @pytest.mark.slow
@@ -120,4 +129,13 @@ def test_result_keys_check_rejects_a_malformed_result():
            "outcome": {"status": "teleported", "reason": ""}}
     with pytest.raises(AssertionError):
         check_result_keys(bad)
-    np.testing.assert_equal(len(OUTCOME_STATUSES), 4)
+    np.testing.assert_equal(set(OUTCOME_STATUSES), {"placed", "lifted", "grasped", "failed"})
+
+
+def test_a_short_simulation_ends_as_timeout():
+    """simulation_duration is honoured: 0.5 s is too short to pick and place."""
+    result = run("default", simulation_duration=0.5)
+    check_result_keys(result)
+    assert (result["outcome"]["status"], result["outcome"]["reason"]) == ("failed", "timeout")
+    assert result["timings"]["simulated_time"] == pytest.approx(0.5, abs=1e-9)
+    assert result["config"]["simulation_duration"] == 0.5

@@ -2,18 +2,17 @@
 
 `scenarios/regression/expected.yaml` holds, per scenario, the category argmax, the set the best
 task(s) must lie in, the part, the least accepted outcome and the tolerance for what may vary. Each
-scenario runs once (end to end, about 10–25 s); each aspect is its own test, so a known failure of
-one aspect (`known_failure`, an expected failure, strict) does not hide the others.
+scenario runs once per session (end to end, about 10–25 s, shared with the other scenario tests);
+each aspect is its own test, so a known failure of one aspect (`known_failure`, an expected
+failure, strict) does not hide the others.
 """
 
-from functools import cache
 from pathlib import Path
 
 import pytest
 import yaml
 
-from tg_drake.run import FAILURE_REASONS, OUTCOME_STATUSES, run_scenario
-from tg_drake.scenario import load_scenario
+from tg_drake.systems.supervisor import FAILURE_REASONS, OUTCOME_STATUSES
 from tg_drake.types import CATEGORIES, PART_LABELS, TASKS
 
 FOLDER = Path(__file__).resolve().parents[2] / "scenarios" / "regression"
@@ -38,19 +37,13 @@ def test_expectations_name_real_scenarios_and_values():
         assert set(e.get("known_failure") or {}) <= set(ASPECTS), name
 
 
-@cache
-def result_of(name: str) -> dict:
-    scenario = load_scenario(FOLDER / f"{name}.yaml")
-    return run_scenario(scenario, scenario_path=f"scenarios/regression/{name}.yaml")
-
-
 def best(distribution: dict) -> set:
     top = max(distribution.values())
     return {k for k, v in distribution.items() if v >= top - 1e-9}
 
 
-def check(name: str, aspect: str) -> None:
-    e, r = EXPECTED[name], result_of(name)
+def check(name: str, aspect: str, r: dict) -> None:
+    e = EXPECTED[name]
     if aspect == "category":
         winners = best(r["category"])
         assert winners == {e["category"]}, f"category argmax {winners} (ties fail)"
@@ -80,5 +73,5 @@ CASES = [pytest.param(name, aspect, id=f"{name}-{aspect}",
 
 
 @pytest.mark.parametrize("name, aspect", CASES)
-def test_regression(name, aspect):
-    check(name, aspect)
+def test_regression(name, aspect, cached_run):
+    check(name, aspect, cached_run(FOLDER / f"{name}.yaml"))

@@ -1,17 +1,16 @@
-"""GraspPlanner alone (fixed inputs) and in a small loop with a stand-in for the logic."""
+"""GraspPlanner alone (fixed inputs): it plans the attempt it is asked for and reports which part
+failed and why (what to do about it is the Supervisor's: tests/systems/test_supervisor.py)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from conftest import grasp_pose
-from pydrake.common.value import AbstractValue
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder, LeafSystem
-from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource
 
 from tg_drake.planning.planner import PlannerConfig
-from tg_drake.systems.grasp_planner import GraspPlanner, PlanStatus
+from tg_drake.systems.grasp_planner import GraspPlanner
+from tg_drake.systems.plan_messages import PlanRequest, PlanStatus
 from tg_drake.types import (PART_LABELS, GraspCandidates, ObjectDescription, PartBox,
                             SceneDescription)
 
@@ -117,55 +116,65 @@ def test_follows_the_plan_after_the_planning_event(reachable_run):
     simulator.AdvanceTo(START + plan.duration + 0.1)
     assert status(planner, context).status == "done"
     np.testing.assert_allclose(desired(planner, context)[7:], 0.0, atol=1e-12)
-    assert planner.get_collisions_output_port().Eval(context) == ()
+    assert status(planner, context).unreachable_parts == ()
 
 
-def test_unreachable_leading_part_becomes_a_collision():
-    """The bottom leads the ranking but can only be grasped from under the table: after the
-    first event `collisions` lists it (still planning); the next event plans the top."""
+def test_unreachable_leading_part_is_reported_and_the_next_attempt_leaves_it_out():
+    """The bottom leads the ranking but can only be grasped from under the table: the first
+    attempt fails and names it (the arm holds on); asked again without it, the next event plans
+    the top."""
     planner = GraspPlanner(place_xy=(0.75, -0.25), start_time=START)
     grasps = ranked([(FROM_BELOW[0], "bottom"), (FROM_BELOW[1], "bottom"), (TOP, "top")])
     context = fixed_inputs(planner, SCENE, grasps)
+    planner.get_plan_request_input_port().FixValue(context, PlanRequest(attempt=1))
     simulator = Simulator(planner, context)
     simulator.Initialize()
     simulator.AdvanceTo(START + 0.01)
-    assert planner.get_collisions_output_port().Eval(context) == ("bottom",)
     s = status(planner, context)
-    assert (s.status, s.requeries, s.unreachable_parts) == ("planning", 1, ("bottom",))
+    assert (s.status, s.attempt, s.unreachable_parts, s.failed_part) == (
+        "failed", 1, ("bottom",), "bottom")
+    assert s.reason
     np.testing.assert_array_equal(desired(planner, context)[:7], Q_MEASURED)  # still holding
-    simulator.AdvanceTo(START + 0.06)  # the next event, 0.05 s later
+    simulator.AdvanceTo(START + 0.06)  # the same request is answered once only
+    assert (status(planner, context).status, status(planner, context).attempt) == ("failed", 1)
+    planner.get_plan_request_input_port().FixValue(
+        context, PlanRequest(attempt=2, exclude_parts=("bottom",)))
+    simulator.AdvanceTo(START + 0.11)  # the next event, 0.05 s later
     s = status(planner, context)
-    assert (s.status, s.part, s.candidate) == ("executing", "top", 2)
-    assert s.t_plan == pytest.approx(START + 0.05, abs=1e-9)
+    assert (s.status, s.attempt, s.part, s.candidate) == ("executing", 2, "top", 2)
+    assert s.t_plan == pytest.approx(START + 0.10, abs=1e-9)
 
 
-def test_gives_up_when_no_part_is_left():
+def test_without_a_request_nothing_is_planned():
+    planner = GraspPlanner(place_xy=(0.75, -0.25), start_time=0.0)
+    context = fixed_inputs(planner, SCENE, ranked([(TOP, "top")]))
+    planner.get_plan_request_input_port().FixValue(context, PlanRequest(attempt=0))
+    simulator = Simulator(planner, context)
+    simulator.Initialize()
+    simulator.AdvanceTo(0.11)
+    s = status(planner, context)
+    assert (s.status, s.attempt, s.plan) == ("planning", 0, None)
+
+
+def test_nothing_left_to_try_blames_no_part():
+    """Every part excluded: the attempt fails without naming a part."""
     planner = GraspPlanner(place_xy=(0.75, -0.25), start_time=0.0)
     far = scene_with_box([1.6, 0.0, 0.10])
     grasps = ranked([(grasp_pose([1.6, 0.0, 0.15], [1, 0, 0], [0, 1, 0]), "middle"),
                      (grasp_pose([1.6, 0.0, 0.17], [0, 0, -1], [0, 1, 0]), "top")])
     context = fixed_inputs(planner, far, grasps)
+    planner.get_plan_request_input_port().FixValue(context, PlanRequest(attempt=1))
     simulator = Simulator(planner, context)
     simulator.Initialize()
-    simulator.AdvanceTo(0.16)  # events at 0, 0.05, 0.10, 0.15
-    s = status(planner, context)
-    assert s.status == "unreachable"
-    assert s.unreachable_parts == ("middle", "top")
-    assert s.requeries == 2
-    assert "no candidate grasps left" in s.reason
-    np.testing.assert_array_equal(desired(planner, context)[:7], Q_MEASURED)  # holds on
-
-
-def test_gives_up_after_max_requeries():
-    planner = GraspPlanner(place_xy=(0.75, -0.25), start_time=0.0, max_requeries=0)
-    grasps = ranked([(FROM_BELOW[0], "bottom"), (TOP, "top")])
-    context = fixed_inputs(planner, SCENE, grasps)
-    simulator = Simulator(planner, context)
-    simulator.Initialize()
+    simulator.AdvanceTo(0.01)
+    assert status(planner, context).failed_part == "middle"  # out of reach
+    planner.get_plan_request_input_port().FixValue(
+        context, PlanRequest(attempt=2, exclude_parts=("middle", "top")))
     simulator.AdvanceTo(0.06)
     s = status(planner, context)
-    assert (s.status, s.requeries, s.unreachable_parts) == ("unreachable", 0, ("bottom",))
-    assert s.reason.startswith("gave up after 0 re-queries")
+    assert (s.status, s.attempt, s.failed_part) == ("failed", 2, None)
+    assert "no candidate grasps left" in s.reason
+    np.testing.assert_array_equal(desired(planner, context)[:7], Q_MEASURED)  # holds on
 
 
 def test_unreachable_place_gives_up_without_blaming_the_part():
@@ -175,50 +184,5 @@ def test_unreachable_place_gives_up_without_blaming_the_part():
     simulator.Initialize()
     simulator.AdvanceTo(0.01)
     s = status(planner, context)
-    assert (s.status, s.unreachable_parts, s.requeries) == ("unreachable", (), 0)
+    assert (s.status, s.unreachable_parts, s.failed_part) == ("failed", (), None)
     assert "picked but not placed" in s.reason
-    assert planner.get_collisions_output_port().Eval(context) == ()
-
-
-class _RankerWithoutCollisions(LeafSystem):
-    """A stand-in for the logic + DGI: the given candidates without those of parts in
-    `collisions` (as collision(Part) evidence sets their probability to 0); counts its calls."""
-
-    def __init__(self, grasps: GraspCandidates):
-        super().__init__()
-        self.grasps = grasps
-        self.seen = []
-        self._collisions = self.DeclareAbstractInputPort("collisions", AbstractValue.Make(()))
-        self.DeclareAbstractOutputPort("ranked_grasps", lambda: AbstractValue.Make(grasps),
-                                       self._calc)
-
-    def _calc(self, context, output):
-        collisions = self._collisions.Eval(context)
-        self.seen.append(collisions)
-        keep = np.array([PART_LABELS[p] not in collisions for p in self.grasps.parts], bool)
-        g = self.grasps
-        output.set_value(GraspCandidates(g.X_WG[keep], g.parts[keep], g.p_part[keep],
-                                         g.p_local[keep], g.score[keep]))
-
-
-def test_collisions_feed_back_without_an_algebraic_loop():
-    builder = DiagramBuilder()
-    planner = builder.AddSystem(GraspPlanner(place_xy=(0.75, -0.25), start_time=0.0))
-    ranker = builder.AddSystem(_RankerWithoutCollisions(
-        ranked([(FROM_BELOW[0], "bottom"), (FROM_BELOW[1], "bottom"), (TOP, "top")])))
-    scene = builder.AddSystem(ConstantValueSource(AbstractValue.Make(SCENE)))
-    arm = builder.AddSystem(ConstantVectorSource(np.concatenate([Q_MEASURED, np.zeros(7)])))
-    builder.Connect(planner.get_collisions_output_port(), ranker.get_input_port())
-    builder.Connect(ranker.get_output_port(), planner.get_ranked_grasps_input_port())
-    builder.Connect(scene.get_output_port(), planner.get_scene_description_input_port())
-    builder.Connect(arm.get_output_port(), planner.get_iiwa_state_input_port())
-    diagram = builder.Build()  # raises on an algebraic loop
-    simulator = Simulator(diagram)
-    simulator.Initialize()
-    simulator.AdvanceTo(0.06)
-    context = planner.GetMyContextFromRoot(simulator.get_context())
-    s = status(planner, context)
-    assert (s.status, s.part, s.requeries) == ("executing", "top", 1)
-    # The second event saw the re-ranked grasps: the top candidate is index 0 of those.
-    assert s.candidate == 0
-    assert ("bottom",) in ranker.seen

@@ -21,6 +21,7 @@ import zlib
 from pathlib import Path
 
 from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.types import THEORY_VARIANTS as VARIANTS
 from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
 
 # Start-up: `tg-drake --help` imports this module, so the suite, scenario, table and job modules
@@ -137,7 +138,6 @@ def main(args) -> int:
                             f"{args.name!r}", field="--name")
     cases = load_cases(args.suites)
     if args.theory != "specific":
-        from tg_drake.logic.theory import VARIANTS  # start-up (ProbLog)
 
         if args.theory not in VARIANTS:
             raise unknown_name("theory", args.theory, VARIANTS, error=ScenarioError,

@@ -11,7 +11,7 @@ import dataclasses
 import json
 from pathlib import Path
 
-from tg_drake.logic.theory import VARIANTS
+from tg_drake.types import THEORY_VARIANTS as VARIANTS
 
 HELP = "ask the ProbLog theory for category, task and pre-grasp part on given observations"
 

@@ -33,10 +33,7 @@ from problog.logic import And, AnnotatedDisjunction, Clause, Constant, Not, Term
 from problog.program import PrologFile
 
 from tg_drake.errors import RuleError, unknown_name
-
-# "learned": the probabilities fitted to simulated grasps (tg_drake/logic/learning.py,
-# tools/learn_theory.py), in rules/category_learned.pl and rules/grasp_learned.pl.
-VARIANTS: tuple[str, ...] = ("specific", "general", "learned")
+from tg_drake.types import THEORY_VARIANTS as VARIANTS
 
 # Files of every variant, in load order; {category} and {grasp} are the variant names.
 THEORY_FILES: tuple[str, ...] = (

@@ -1,10 +1,10 @@
-"""The grasp planner as a Drake system, closing the loop with the logic (paper IV-D and VI).
+"""The grasp planner as a Drake system: motion only (paper VI).
 
-The paper's constraint `false :- grasp(X, T, R), part(R, X), collision(R).` connects the reasoning
-module to the execution planner: a part the gripper cannot reach becomes `collision(Part)`
-evidence. `GraspPlanner` keeps the parts it found unreachable in its state and publishes them on
-its ``collisions`` output, which the diagram feeds back to `LogicQuerySystem`; the logic asks again
-and the next ``ranked_grasps`` ranks the remaining parts.
+`GraspPlanner` plans a pick-and-place for the best candidate it is allowed and reports on
+``plan_status`` whether it succeeded or which part failed and why. What to do next (feed the
+unreachable part back to the logic as `collision(Part)` evidence and ask again, or give up) is the
+`tg_drake.systems.supervisor.Supervisor`'s policy: it tells the planner what to plan through the
+``plan_request`` input.
 """
 
 from __future__ import annotations
@@ -17,29 +17,15 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
-from tg_drake.errors import ScenarioError, unknown_name
-from tg_drake.planning.planner import Plan, PlannerConfig, PlanResult, plan_for_scene
-from tg_drake.scenario import IIWA_HOME, Scenario
-from tg_drake.types import PART_LABELS, GraspCandidates, SceneDescription
+from tg_drake.planning.planner import PlannerConfig, PlanResult, plan_for_scene
+from tg_drake.robot import IIWA_HOME
+from tg_drake.scenario import Scenario
+from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
+from tg_drake.types import GraspCandidates, SceneDescription
 
 
-@dataclass(frozen=True)
-class PlanStatus:
-    """Value of the ``plan_status`` output."""
-
-    status: str  # "planning", "executing", "done" or "unreachable"
-    part: str | None = None  # the chosen part
-    candidate: int | None = None  # index of the chosen candidate in the ranked_grasps it came from
-    X_WG: np.ndarray | None = None  # 4×4 chosen grasp pose
-    unreachable_parts: tuple = ()  # parts found unreachable (the collision(Part) evidence)
-    requeries: int = 0  # how often the logic was asked again with new collision evidence
-    reason: str = ""  # why planning failed (status "unreachable"), else ""
-    planning_time: float = 0.0  # [s] wall time spent in the planner so far
-    t_plan: float | None = None  # [s] simulated time at which the plan starts
-    plan: Plan | None = None  # the plan itself (key times in plan time: add t_plan)
-
-    def __deepcopy__(self, memo):
-        return self  # immutable: Drake's copies of abstract values may share it
+# Without a connected ``plan_request`` the planner makes one attempt with no exclusions.
+_ONE_ATTEMPT = PlanRequest(attempt=1)
 
 
 @dataclass(frozen=True)
@@ -47,11 +33,11 @@ class _Memory:
     """The planner's abstract state. Immutable: updates replace it."""
 
     q_hold: np.ndarray  # (7,) posture held before a plan exists (measured at initialisation)
-    collisions: tuple = ()  # parts found unreachable so far
-    requeries: int = 0
+    attempt: int = 0  # the last request answered
     result: PlanResult | None = None  # the successful planning result
     t_plan: float | None = None  # [s] simulated time the plan starts
-    failure: str = ""  # non-empty: planning gave up, and why
+    failure: PlanResult | None = None  # the last answered attempt's failed result
+    failure_reason: str = ""  # its reason (also for failures without a PlanResult)
     planning_time: float = 0.0  # [s] wall time
 
     def __deepcopy__(self, memo):
@@ -59,7 +45,7 @@ class _Memory:
 
 
 class GraspPlanner(LeafSystem):
-    """Plans a pick-and-place for the best reachable grasp and commands the arm and the gripper.
+    """Plans a pick-and-place for the best allowed grasp and commands the arm and the gripper.
 
     .. pydrake_system::
 
@@ -68,50 +54,44 @@ class GraspPlanner(LeafSystem):
         - scene_description
         - ranked_grasps
         - iiwa.state
+        - plan_request (optional)
         output_ports:
         - iiwa.desired_state
         - wsg.position
-        - collisions
         - plan_status
 
     ``scene_description`` (`SceneDescription`) gives the target (``ranked_grasps.target``) and the
     other objects, whose boxes are obstacles; ``ranked_grasps`` (`GraspCandidates`) are the grasp
-    poses, best first; ``iiwa.state`` (14: q, v) is the measured arm state.
+    poses, best first; ``iiwa.state`` (14: q, v) is the measured arm state; ``plan_request``
+    (`PlanRequest`) says which attempt to plan and which parts to leave out (not connected: one
+    attempt, nothing left out).
 
     At initialisation the measured posture is stored; until a plan exists ``iiwa.desired_state``
     holds it (zero velocity) and ``wsg.position`` holds the gripper open. From `start_time` on, a
-    periodic unrestricted update (every `period` seconds, until planning succeeds or gives up)
-    plans for the leading part of ``ranked_grasps`` (its candidates best first, parts already
-    found unreachable skipped; `tg_drake.planning.planner.plan_pick_and_place`). If every
-    candidate of that part fails, the part joins the state's collisions, published on
-    ``collisions`` (a tuple of part names, from state only: feeding it back to the logic makes no
-    algebraic loop); the next event sees the re-ranked grasps. Planning gives up (status
-    "unreachable") when no part is left or after `max_requeries` re-queries. Once a plan exists,
-    ``iiwa.desired_state`` (q, v) and ``wsg.position`` (opening width [m]; closing is commanded
-    as width `PlannerConfig.closed_width`, the WSG driver's force limit sets the grip) follow it
-    in time from the event at which it was made.
+    periodic unrestricted update (every `period` seconds) answers a request it has not answered
+    yet: it plans for the leading part of ``ranked_grasps`` without the request's excluded parts
+    (its candidates best first; `tg_drake.planning.planner.plan_pick_and_place` with one part).
+    Once a plan exists, ``iiwa.desired_state`` (q, v) and ``wsg.position`` (opening width [m];
+    closing is commanded as width `PlannerConfig.closed_width`, the WSG driver's force limit sets
+    the grip) follow it in time from the event at which it was made; later requests are ignored.
 
-    ``plan_status`` is a `PlanStatus`: "planning", "executing", "done" or "unreachable", with the
-    chosen part and candidate, the unreachable parts, the re-query count and the reason.
+    ``plan_status`` is a `PlanStatus` (from state and time only: feeding it to a supervisor whose
+    outputs feed the logic makes no algebraic loop): planning, executing, done or failed,
+    with the attempt answered, the chosen part and candidate, or the part that failed and why
+    ("failed" stays until the next attempt is answered).
     """
 
     def __init__(self, *, place_xy, start_time: float = 0.0, period: float = 0.05,
-                 max_requeries: int = 3, config: PlannerConfig | None = None,
-                 scenario: Scenario | None = None, grasp_part: str | None = None):
+                 config: PlannerConfig | None = None, scenario: Scenario | None = None):
         """
         Args:
             place_xy: (2,) world xy where the target object's frame origin is placed [m].
             start_time: simulated time of the first planning event [s] (e.g. after perception
                 has seen the scene).
-            period: spacing of the planning events until a plan exists [s].
-            max_requeries: how many times the logic may be asked again with new collision
-                evidence before the planner gives up.
+            period: spacing of the planning events [s].
             config: the planner's distances, clearances, timing and limits.
             scenario: whose robot and table models the planner's arm plant uses (default: the
                 station's).
-            grasp_part: only hypotheses of this part are tried, by the DGI's P(grasp | shape)
-                alone (`only_part`); None: all, by score. For data collection
-                (tools/learn_theory.py), so that outcomes exist for parts the logic would not pick.
         """
         super().__init__()
         if len(place_xy) != 2:
@@ -119,19 +99,16 @@ class GraspPlanner(LeafSystem):
         if period <= 0 or start_time < 0:
             raise ValueError(f"need period > 0 and start_time >= 0, got {period}, {start_time}")
         self._place_xy = np.asarray(place_xy, float)
-        self._max_requeries = int(max_requeries)
         self._config = config or PlannerConfig()
         self._scenario = scenario
-        if grasp_part is not None and grasp_part not in PART_LABELS:
-            raise unknown_name("part", grasp_part, PART_LABELS, error=ScenarioError,
-                               field="grasp_part")
-        self._grasp_part = grasp_part
 
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
         self._grasps_port = self.DeclareAbstractInputPort(
             "ranked_grasps", AbstractValue.Make(_no_candidates()))
         self._state_port = self.DeclareVectorInputPort("iiwa.state", 14)
+        self._request_port = self.DeclareAbstractInputPort(
+            "plan_request", AbstractValue.Make(PlanRequest()))
 
         self._memory = self.DeclareAbstractState(
             AbstractValue.Make(_Memory(q_hold=np.asarray(IIWA_HOME, float))))
@@ -146,11 +123,8 @@ class GraspPlanner(LeafSystem):
             prerequisites_of_calc=on_state_and_time)
         self._wsg_port = self.DeclareVectorOutputPort(
             "wsg.position", 1, self._calc_wsg_position, prerequisites_of_calc=on_state_and_time)
-        self._collisions_port = self.DeclareAbstractOutputPort(
-            "collisions", lambda: AbstractValue.Make(()), self._calc_collisions,
-            prerequisites_of_calc=on_state)
         self._status_port = self.DeclareAbstractOutputPort(
-            "plan_status", lambda: AbstractValue.Make(PlanStatus("planning")),
+            "plan_status", lambda: AbstractValue.Make(PlanStatus(PlanState.planning)),
             self._calc_status, prerequisites_of_calc=on_state_and_time)
 
     # Port accessors.
@@ -163,14 +137,14 @@ class GraspPlanner(LeafSystem):
     def get_iiwa_state_input_port(self):
         return self._state_port
 
+    def get_plan_request_input_port(self):
+        return self._request_port
+
     def get_iiwa_desired_state_output_port(self):
         return self._desired_state_port
 
     def get_wsg_position_output_port(self):
         return self._wsg_port
-
-    def get_collisions_output_port(self):
-        return self._collisions_port
 
     def get_plan_status_output_port(self):
         return self._status_port
@@ -180,42 +154,39 @@ class GraspPlanner(LeafSystem):
         q = np.asarray(self._state_port.Eval(context), float)[:7]
         state.get_mutable_abstract_state(self._memory).set_value(_Memory(q_hold=q.copy()))
 
+    def _request(self, context) -> PlanRequest:
+        if not self._request_port.HasValue(context):
+            return _ONE_ATTEMPT
+        return self._request_port.Eval(context)
+
     def _plan(self, context, state):
         memory: _Memory = context.get_abstract_state(self._memory).get_value()
-        if memory.result is not None or memory.failure:
+        request = self._request(context)
+        if memory.result is not None or request.attempt <= memory.attempt:
             return EventStatus.DidNothing()
         scene: SceneDescription = self._scene_port.Eval(context)
         grasps: GraspCandidates = self._grasps_port.Eval(context)
-        if self._grasp_part is not None:
-            grasps = only_part(grasps, self._grasp_part)
         t0 = time.perf_counter()
+        memory = dataclasses.replace(memory, attempt=request.attempt, failure=None,
+                                     failure_reason="")
         if len(grasps.score) == 0 or not scene.objects:
             memory = dataclasses.replace(
-                memory, failure="no grasp candidates" if scene.objects else "no objects seen")
+                memory,
+                failure_reason="no grasp candidates" if scene.objects else "no objects seen")
         else:
             result = plan_for_scene(scene, grasps, place_xy=self._place_xy,
                                     q_start=memory.q_hold, config=self._config,
-                                    scenario=self._scenario, exclude_parts=memory.collisions,
-                                    max_parts=1)
-            memory = self._after(memory, result, context.get_time())
+                                    scenario=self._scenario,
+                                    exclude_parts=tuple(request.exclude_parts), max_parts=1)
+            if result.status == "planned":
+                memory = dataclasses.replace(memory, result=result, t_plan=context.get_time())
+            else:
+                memory = dataclasses.replace(memory, failure=result,
+                                             failure_reason=result.reason)
         memory = dataclasses.replace(
             memory, planning_time=memory.planning_time + time.perf_counter() - t0)
         state.get_mutable_abstract_state(self._memory).set_value(memory)
         return EventStatus.Succeeded()
-
-    def _after(self, memory: _Memory, result: PlanResult, t: float) -> _Memory:
-        if result.status == "planned":
-            return dataclasses.replace(memory, result=result, t_plan=t)
-        new = tuple(p for p in result.unreachable_parts if p not in memory.collisions)
-        if not new:  # nothing new to tell the logic: no part left to try
-            return dataclasses.replace(memory, failure=result.reason)
-        collisions = memory.collisions + new
-        if memory.requeries >= self._max_requeries:
-            return dataclasses.replace(
-                memory, collisions=collisions,
-                failure=f"gave up after {memory.requeries} re-queries; {result.reason}")
-        return dataclasses.replace(memory, collisions=collisions,
-                                   requeries=memory.requeries + 1)
 
     # Outputs.
     def _memory_of(self, context) -> _Memory:
@@ -237,34 +208,23 @@ class GraspPlanner(LeafSystem):
             return
         output.SetAtIndex(0, memory.result.plan.width(context.get_time() - memory.t_plan))
 
-    def _calc_collisions(self, context, output):
-        output.set_value(self._memory_of(context).collisions)
-
     def _calc_status(self, context, output):
         memory = self._memory_of(context)
-        common = dict(unreachable_parts=memory.collisions, requeries=memory.requeries,
-                      planning_time=memory.planning_time)
-        if memory.failure:
-            output.set_value(PlanStatus("unreachable", reason=memory.failure, **common))
+        common = dict(attempt=memory.attempt, planning_time=memory.planning_time)
+        if memory.result is not None:
+            plan = memory.result.plan
+            done = context.get_time() - memory.t_plan >= plan.duration
+            output.set_value(PlanStatus(PlanState.done if done else PlanState.executing,
+                                        part=plan.part, candidate=plan.candidate,
+                                        X_WG=plan.X_WG_grasp, t_plan=memory.t_plan, plan=plan,
+                                        **common))
             return
-        if memory.result is None:
-            output.set_value(PlanStatus("planning", **common))
+        if memory.failure_reason:
+            unreachable = memory.failure.unreachable_parts if memory.failure is not None else ()
+            output.set_value(PlanStatus(PlanState.failed, unreachable_parts=tuple(unreachable),
+                                        reason=memory.failure_reason, **common))
             return
-        plan = memory.result.plan
-        done = context.get_time() - memory.t_plan >= plan.duration
-        output.set_value(PlanStatus("done" if done else "executing", part=plan.part,
-                                    candidate=plan.candidate, X_WG=plan.X_WG_grasp,
-                                    t_plan=memory.t_plan, plan=plan, **common))
-
-
-def only_part(grasps: GraspCandidates, part: str) -> GraspCandidates:
-    """The candidates with the score of every hypothesis of another part set to 0 (ruled out) and
-    that of `part`'s hypotheses set to P(grasp | shape): the logic's P(part | task) is the same
-    for all hypotheses of a part, so their order is kept, and a part the logic gives 0 is still
-    tried. Indices are unchanged (the plan's `candidate` indexes ``ranked_grasps``)."""
-    mine = np.asarray(grasps.parts) == PART_LABELS.index(part)
-    score = np.where(mine, np.asarray(grasps.p_local, float), 0.0)
-    return dataclasses.replace(grasps, score=score)
+        output.set_value(PlanStatus(PlanState.planning, **common))
 
 
 def _no_candidates() -> GraspCandidates:

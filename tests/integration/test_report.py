@@ -1,0 +1,24 @@
+"""tg_drake.report.write: result.json first, the pictures after; a picture that fails is a
+warning, never a lost result."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from tg_drake.report import Pictures, Stages, write
+from tg_drake.types import SceneDescription
+
+
+def test_a_failing_picture_is_a_warning_and_the_result_is_kept(tmp_path):
+    result = {"scenario": "x", "outcome": {"status": "placed", "reason": "", "detail": ""},
+              "grasp": {"part": "middle", "score": 0.5, "p_part": 0.5, "p_local": 1.0}}
+    # An object that is not an ObjectDescription: parts.png and grasp.png cannot be drawn.
+    broken = SceneDescription(objects=[object()], X_WT=np.eye(4), target=0)
+    pictures = Pictures(Stages(scene=broken, rgb=np.zeros((4, 6, 3), np.uint8)), X_WG=np.eye(4))
+    warnings = write(tmp_path, result, pictures)
+    assert json.loads((tmp_path / "result.json").read_text()) == result
+    assert (tmp_path / "camera.png").is_file()
+    assert sorted(w.split()[0] for w in warnings) == ["grasp.png", "parts.png"]
+    assert not (tmp_path / "parts.png").exists()

@@ -1,0 +1,69 @@
+"""Every scenario in scenarios/ ends the same through `tg-drake run` (`tg_drake.run.run_scenario`)
+and through a diagram composed by hand with `add_pipeline`, simulated until the supervisor's
+outcome is final (the README's "Composing your own diagram").
+
+Both paths share the supervisor, so the logic's veto, the re-query policy and the execution
+monitor are the same; only the driving loop differs (the hand loop uses a default `Simulator` and
+steps of `STEP`). Each scenario runs once per path (the run_scenario result is shared with the
+regression and pipeline tests).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+
+from tg_drake.diagram import add_pipeline
+from tg_drake.scenario import load_scenario, scenario_names
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+STEP = 0.25  # [s] simulated time between looks at the outcome in the hand-driven loop
+
+
+def scenario_cases() -> list:
+    """(file, entry) for every top-level and regression scenario file (each named entry of a
+    multi-scenario file); suites are lists of cases, not scenarios."""
+    files = sorted(SCENARIOS.glob("*.yaml")) + sorted(
+        p for p in (SCENARIOS / "regression").glob("*.yaml") if p.stem != "expected")
+    cases = []
+    for path in files:
+        names = scenario_names(path)
+        for name in names or [None]:
+            label = str(path.relative_to(SCENARIOS)) + (f"#{name}" if name else "")
+            cases.append(pytest.param(path, name, id=label))
+    return cases
+
+
+def outcome_by_hand(path: Path, name: str | None) -> tuple[str, str]:
+    scenario = load_scenario(path, scenario_name=name)
+    builder = DiagramBuilder()
+    pipeline = add_pipeline(builder, scenario=scenario)
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    supervisor_context = pipeline.supervisor.GetMyContextFromRoot(context)
+    outcome_port = pipeline.ports["outcome"]
+    simulator.Initialize()
+    outcome = outcome_port.Eval(supervisor_context)
+    while not outcome.final and context.get_time() < scenario.simulation_duration:
+        simulator.AdvanceTo(min(context.get_time() + STEP, scenario.simulation_duration))
+        outcome = outcome_port.Eval(supervisor_context)
+    if not outcome.final:
+        return "failed", "timeout"
+    return outcome.status.value, outcome.reason.value
+
+
+def test_every_scenario_file_is_a_case():
+    ids = {c.id for c in scenario_cases()}
+    assert "default.yaml" in ids and "regression/pan_upside_down.yaml" in ids
+    assert not any("expected" in i for i in ids)
+
+
+@pytest.mark.parametrize("path, name", scenario_cases())
+def test_run_and_composed_diagram_agree(path, name, cached_run):
+    result = cached_run(path, name)
+    through_run = (result["outcome"]["status"], result["outcome"]["reason"])
+    assert outcome_by_hand(path, name) == through_run, result["outcome"]

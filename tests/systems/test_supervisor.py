@@ -1,0 +1,308 @@
+"""Supervisor alone (fixed inputs) and in a small loop with the real planner and a stand-in for
+the logic and the scorer: the gate, re-checked after every re-query; the re-query policy; waiting
+for plans. (The execution monitor runs on a plant: tests/integration/test_grasp_planner_station.py
+and the scenario tests.)"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pydrake.common.value import AbstractValue
+from pydrake.math import RigidTransform
+from pydrake.multibody.plant import ContactResults
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource
+
+from tg_drake.outcome import HandGeometries
+from tg_drake.systems.grasp_planner import GraspPlanner
+from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
+from tg_drake.systems.supervisor import (MonitorModel, Outcome, Reason, Status, Supervisor,
+                                         SupervisorConfig)
+from tg_drake.types import (PART_LABELS, GraspCandidates, GraspSemantics, ObjectDescription,
+                            PartBox, SceneDescription)
+
+# No plant: the gate and the re-query policy never read the monitor's geometry.
+NO_MODEL = MonitorModel(HandGeometries(frozenset(), frozenset(), frozenset(), frozenset()),
+                        object_body=0, gripper_body=0)
+CONFIG = SupervisorConfig(planning_start=0.0, period=0.01, planning_timeout=0.5)
+GRASP_POINT = 0.055  # [m] along +y_G from the WSG body origin
+Q_MEASURED = np.array([0.1, -0.5, 0.05, -1.8, 0.0, 1.1, 0.2])  # a posture near IIWA_HOME
+
+
+def grasp_pose(p_W_grasp, approach_W, closing_W) -> np.ndarray:
+    y, x = np.asarray(approach_W, float), np.asarray(closing_W, float)
+    X = np.eye(4)
+    X[:3, :3] = np.column_stack([x, y, np.cross(x, y)])
+    X[:3, 3] = np.asarray(p_W_grasp, float) - GRASP_POINT * y
+    return X
+
+
+def scene_with_box(p_W_center, extents=(0.07, 0.07, 0.20)) -> SceneDescription:
+    """One upright box on the table, bottom / middle / top thirds as its parts."""
+    extents = np.asarray(extents, float)
+    X_WO = np.eye(4)
+    X_WO[:3, 3] = p_W_center
+    boxes = {}
+    for k, name in enumerate(("bottom", "middle", "top")):
+        X_WB = X_WO.copy()
+        X_WB[2, 3] += -extents[2] / 2 + extents[2] * (k + 0.5) / 3
+        boxes[name] = PartBox(X_WB, np.array([extents[0], extents[1], extents[2] / 3]) / 2)
+    box = ObjectDescription(
+        p_W=np.zeros((0, 3)), n_W=np.zeros((0, 3)), labels=np.zeros(0, int),
+        visible=np.zeros(0, bool), X_WO=X_WO, extents=extents, pose="upright",
+        pose_likelihood={"upright": 1.0}, part_probabilities=dict.fromkeys(boxes, 1.0),
+        part_boxes=boxes, pregrasp_X_WG=np.zeros((0, 4, 4)), pregrasp_parts=np.zeros(0, int))
+    return SceneDescription(objects=[box], X_WT=np.eye(4), target=0)
+
+
+def ranked(poses_and_parts) -> GraspCandidates:
+    X = np.array([X for X, _ in poses_and_parts])
+    parts = np.array([PART_LABELS.index(p) for _, p in poses_and_parts])
+    score = np.linspace(0.9, 0.5, len(parts))
+    return GraspCandidates(X_WG=X, parts=parts, p_part=score, p_local=np.ones(len(parts)),
+                           score=score)
+
+
+def semantics(grasp_probability=0.5, part=None, collisions=()) -> GraspSemantics:
+    return GraspSemantics(category={"cup": 1.0}, task={"pass": 1.0},
+                          part=part or {"bottom": 0.6, "top": 0.4}, given_task="pass",
+                          collisions=tuple(collisions), grasp_probability=grasp_probability)
+
+
+SCENE = scene_with_box([0.75, 0.1, 0.10])
+TOP = grasp_pose([0.75, 0.1, 0.17], [0, 0, -1], [0, 1, 0])
+FROM_BELOW = grasp_pose([0.75, 0.1, 0.03], [0, 0, 1], [0, 1, 0])  # never reachable
+GRASPS = ranked([(FROM_BELOW, "bottom"), (TOP, "top")])
+
+
+class Fixed:
+    """The supervisor alone, its inputs fixed; `advance` moves simulated time."""
+
+    def __init__(self, *, config=CONFIG, scene=SCENE, meaning=None, grasps=GRASPS):
+        self.supervisor = Supervisor(config=config, model=NO_MODEL)
+        self.context = self.supervisor.CreateDefaultContext()
+        s = self.supervisor
+        s.get_scene_description_input_port().FixValue(self.context, scene)
+        s.get_grasp_semantics_input_port().FixValue(self.context, meaning or semantics())
+        s.get_ranked_grasps_input_port().FixValue(self.context, grasps)
+        self.plan(PlanStatus(PlanState.planning))
+        s.get_wsg_state_input_port().FixValue(self.context, np.zeros(4))
+        s.get_body_poses_input_port().FixValue(self.context, [RigidTransform()])
+        s.get_contact_results_input_port().FixValue(self.context, ContactResults())
+        self.simulator = Simulator(s, self.context)
+        self.simulator.Initialize()
+
+    def plan(self, status: PlanStatus):
+        self.supervisor.get_plan_status_input_port().FixValue(self.context, status)
+
+    def meaning(self, value: GraspSemantics):
+        self.supervisor.get_grasp_semantics_input_port().FixValue(self.context, value)
+
+    def advance(self, t: float):
+        self.simulator.AdvanceTo(t)
+
+    @property
+    def outcome(self) -> Outcome:
+        return self.supervisor.get_outcome_output_port().Eval(self.context)
+
+    @property
+    def request(self) -> PlanRequest:
+        return self.supervisor.get_plan_request_output_port().Eval(self.context)
+
+    @property
+    def collisions(self) -> tuple:
+        return self.supervisor.get_collisions_output_port().Eval(self.context)
+
+
+def failed(attempt, part=None, reason="pre-grasp pose unreachable (test)") -> PlanStatus:
+    return PlanStatus(PlanState.failed, attempt=attempt,
+                      unreachable_parts=(part,) if part else (), reason=reason)
+
+
+def test_gate_passes_and_asks_for_the_first_plan():
+    f = Fixed()
+    assert f.request == PlanRequest(attempt=0) and not f.outcome.final  # before the first check
+    f.advance(0.001)
+    assert f.request == PlanRequest(attempt=1, exclude_parts=())
+    assert (f.outcome.status, f.outcome.final) == (Status.pending, False)
+    assert "attempt 1" in f.outcome.detail
+
+
+@pytest.mark.parametrize("kwargs, detail", [
+    (dict(meaning=semantics(grasp_probability=0.01)), "P(some part is grasped) = 0.010 < 0.03"),
+    (dict(meaning=semantics(part={"bottom": 0.0, "top": 0.0})), "ruled every grasp out"),
+    (dict(grasps=GraspCandidates(GRASPS.X_WG, GRASPS.parts, GRASPS.p_part, GRASPS.p_local,
+                                 np.zeros(2))), "no pre-grasp hypothesis with a non-zero score"),
+])
+def test_the_logic_veto_fails_the_run_before_any_plan(kwargs, detail):
+    f = Fixed(**kwargs)
+    f.advance(0.001)
+    o = f.outcome
+    assert (o.status, o.reason, o.final) == (Status.failed, Reason.logic, True)
+    assert detail in o.detail
+    assert f.request.attempt == 0  # the planner was never asked
+
+
+@pytest.mark.parametrize("scene, detail", [
+    (SceneDescription(objects=[], X_WT=np.eye(4)), "no object on the table"),
+    (SceneDescription(objects=SCENE.objects, X_WT=np.eye(4), target=None), "target's position"),
+])
+def test_nothing_perceived_at_the_target_fails_as_perception(scene, detail):
+    f = Fixed(scene=scene)
+    f.advance(0.001)
+    assert (f.outcome.status, f.outcome.reason) == ("failed", "perception")
+    assert detail in f.outcome.detail
+
+
+def test_an_unreachable_part_becomes_collision_evidence_and_the_planner_is_asked_again():
+    f = Fixed()
+    f.advance(0.001)
+    f.plan(failed(1, "bottom"))
+    f.advance(0.011)  # the check that reads the failure
+    assert f.collisions == ("bottom",)
+    assert f.request.attempt == 1  # not yet: the gate is checked first, with the new evidence
+    assert (f.outcome.final, f.outcome.requeries, f.outcome.unreachable_parts) == (
+        False, 1, ("bottom",))
+    f.meaning(semantics(collisions=("bottom",), part={"bottom": 0.0, "top": 1.0}))
+    f.advance(0.021)
+    assert f.request == PlanRequest(attempt=2, exclude_parts=("bottom",))
+
+
+def test_the_gate_is_checked_again_after_a_requery():
+    """Told the bottom cannot be reached, the logic rules grasping out: the run ends there, as
+    unreachable (the evidence came from the planner), and the planner is not asked again."""
+    f = Fixed()
+    f.advance(0.001)
+    f.plan(failed(1, "bottom"))
+    f.advance(0.011)
+    f.meaning(semantics(grasp_probability=0.01, collisions=("bottom",)))
+    f.advance(0.021)
+    o = f.outcome
+    assert (o.status, o.reason, o.requeries, o.unreachable_parts) == (
+        "failed", "unreachable", 1, ("bottom",))
+    assert "P(some part is grasped) = 0.010" in o.detail and "bottom" in o.detail
+    assert f.request.attempt == 1
+
+
+def test_gives_up_after_max_requeries():
+    f = Fixed(config=SupervisorConfig(planning_start=0.0, period=0.01, max_requeries=0))
+    f.advance(0.001)
+    f.plan(failed(1, "bottom"))
+    f.advance(0.011)
+    o = f.outcome
+    assert (o.status, o.reason, o.requeries, o.unreachable_parts) == (
+        "failed", "unreachable", 0, ("bottom",))
+    assert o.detail.startswith("gave up after 0 re-queries; pre-grasp pose unreachable")
+
+
+def test_the_first_informative_failure_stays_in_the_detail():
+    f = Fixed()
+    f.advance(0.001)
+    f.plan(failed(1, "bottom", reason="pre-grasp pose unreachable (bottom)"))
+    f.advance(0.011)
+    f.advance(0.021)  # the gate again (unchanged semantics pass): attempt 2
+    assert f.request.attempt == 2
+    f.plan(failed(2, None, reason="no candidate grasps left to try"))
+    f.advance(0.031)
+    o = f.outcome
+    assert (o.status, o.reason) == ("failed", "unreachable")
+    assert "no candidate grasps left to try" in o.detail
+    assert "pre-grasp pose unreachable (bottom)" in o.detail
+
+
+def test_no_plan_within_the_planning_timeout_fails_as_timeout():
+    f = Fixed()
+    f.advance(0.49)
+    assert not f.outcome.final
+    f.advance(0.52)
+    assert (f.outcome.status, f.outcome.reason) == ("failed", "timeout")
+    assert "planning_timeout = 0.5 s" in f.outcome.detail
+
+
+def test_a_bad_config_names_its_field():
+    from tg_drake.errors import ScenarioError
+    with pytest.raises(ScenarioError, match="max_requeries"):
+        SupervisorConfig(max_requeries=-1).validate()
+
+
+class _LogicAndScorer(LeafSystem):
+    """A stand-in for the logic + DGI: given collisions, P(some part is grasped) drops to
+    `p_after` and the parts in collision lose their candidates; counts its calls."""
+
+    def __init__(self, grasps: GraspCandidates, *, p_after: float):
+        super().__init__()
+        self.grasps, self.p_after, self.seen = grasps, p_after, []
+        self._collisions = self.DeclareAbstractInputPort("collisions", AbstractValue.Make(()))
+        self.DeclareAbstractOutputPort("grasp_semantics",
+                                       lambda: AbstractValue.Make(semantics()), self._semantics)
+        self.DeclareAbstractOutputPort("ranked_grasps", lambda: AbstractValue.Make(grasps),
+                                       self._ranked)
+
+    def _semantics(self, context, output):
+        collisions = self._collisions.Eval(context)
+        output.set_value(semantics(self.p_after if collisions else 0.5, collisions=collisions))
+
+    def _ranked(self, context, output):
+        collisions = self._collisions.Eval(context)
+        self.seen.append(collisions)
+        keep = np.array([PART_LABELS[p] not in collisions for p in self.grasps.parts], bool)
+        g = self.grasps
+        output.set_value(GraspCandidates(g.X_WG[keep], g.parts[keep], g.p_part[keep],
+                                         g.p_local[keep], g.score[keep]))
+
+
+def closed_loop(p_after: float):
+    """Planner + supervisor + stand-in, the arm's state fixed; simulated to 0.3 s."""
+    builder = DiagramBuilder()
+    config = SupervisorConfig(planning_start=0.0, period=0.01)
+    planner = builder.AddSystem(GraspPlanner(place_xy=(0.75, -0.25), start_time=config.period))
+    supervisor = builder.AddSystem(Supervisor(config=config, model=NO_MODEL))
+    stages = builder.AddSystem(_LogicAndScorer(GRASPS, p_after=p_after))
+    scene = builder.AddSystem(ConstantValueSource(AbstractValue.Make(SCENE)))
+    arm = builder.AddSystem(ConstantVectorSource(np.concatenate([Q_MEASURED, np.zeros(7)])))
+    for port, source in ((planner.get_scene_description_input_port(), scene.get_output_port()),
+                         (supervisor.get_scene_description_input_port(), scene.get_output_port()),
+                         (planner.get_ranked_grasps_input_port(),
+                          stages.GetOutputPort("ranked_grasps")),
+                         (supervisor.get_ranked_grasps_input_port(),
+                          stages.GetOutputPort("ranked_grasps")),
+                         (supervisor.get_grasp_semantics_input_port(),
+                          stages.GetOutputPort("grasp_semantics")),
+                         (planner.get_iiwa_state_input_port(), arm.get_output_port()),
+                         (supervisor.get_plan_status_input_port(),
+                          planner.get_plan_status_output_port()),
+                         (planner.get_plan_request_input_port(),
+                          supervisor.get_plan_request_output_port()),
+                         (stages.get_input_port(), supervisor.get_collisions_output_port())):
+        builder.Connect(source, port)
+    fixed = builder.AddSystem(ConstantVectorSource(np.zeros(4)))
+    builder.Connect(fixed.get_output_port(), supervisor.get_wsg_state_input_port())
+    poses = builder.AddSystem(ConstantValueSource(AbstractValue.Make([RigidTransform()])))
+    builder.Connect(poses.get_output_port(), supervisor.get_body_poses_input_port())
+    contacts = builder.AddSystem(ConstantValueSource(AbstractValue.Make(ContactResults())))
+    builder.Connect(contacts.get_output_port(), supervisor.get_contact_results_input_port())
+    diagram = builder.Build()  # raises on an algebraic loop
+    simulator = Simulator(diagram)
+    simulator.Initialize()
+    simulator.AdvanceTo(0.3)
+    root = simulator.get_context()
+    return (supervisor.get_outcome_output_port().Eval(supervisor.GetMyContextFromRoot(root)),
+            planner.get_plan_status_output_port().Eval(planner.GetMyContextFromRoot(root)),
+            stages)
+
+
+def test_closed_loop_replans_without_the_unreachable_part():
+    outcome, status, stages = closed_loop(p_after=0.5)
+    assert (status.status, status.attempt, status.part) == ("executing", 2, "top")
+    assert status.candidate == 0  # index in the re-ranked grasps, which lack the bottom
+    assert ("bottom",) in stages.seen
+    assert (outcome.final, outcome.unreachable_parts, outcome.requeries) == (
+        False, ("bottom",), 1)
+
+
+def test_closed_loop_stops_when_the_logic_vetoes_after_the_requery():
+    outcome, status, _ = closed_loop(p_after=0.01)
+    assert (outcome.status, outcome.reason) == ("failed", "unreachable")
+    assert "P(some part is grasped) = 0.010" in outcome.detail
+    assert (status.status, status.attempt) == ("failed", 1)  # the top was never planned

@@ -1,0 +1,293 @@
+"""What a run writes: result.json (assembled from port values), the one-screen summary and the
+pictures (the camera view, the part-coloured perceived cloud, the chosen grasp).
+
+`write` puts result.json down first and the pictures after it: a picture that fails is a warning,
+never a lost result.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from pydrake.common.yaml import yaml_dump_typed, yaml_load
+from pydrake.math import RigidTransform, RollPitchYaw
+
+from tg_drake import robot
+from tg_drake.errors import TgDrakeError
+from tg_drake.perception.plot import save_scene_png
+from tg_drake.types import PART_COLORS
+
+
+@dataclass
+class Stages:
+    """The stages' values at the start of the run (evaluated once after `Simulator.Initialize`),
+    and what the pictures need."""
+
+    scene: object = None  # SceneDescription
+    prior: object = None  # CategoryDistribution
+    semantics: object = None  # GraspSemantics
+    ranked: object = None  # GraspCandidates
+    rgb: np.ndarray | None = None  # (H, W, 3) camera image, when pictures are wanted
+    warnings: list = field(default_factory=list)
+
+
+def evaluate_stages(pipeline, context, timings: dict, *, rgb: bool = False) -> Stages:
+    """Each stage's output once, timed on its own (`timings` gets render, perception,
+    kernel_prior, logic, dgi_scoring [s] of wall time). A stage's error stops here: the
+    supervisor meets it again and makes it the outcome."""
+    stages = Stages()
+    station = pipeline.station
+
+    def timed(name, port):
+        t0 = time.perf_counter()
+        value = port.Eval(port.get_system().GetMyContextFromRoot(context))
+        timings[name] = time.perf_counter() - t0
+        return value
+
+    # The camera perception looks through (the first camera for ground-truth perception).
+    camera = getattr(pipeline.config.perception, "camera", next(iter(station.cameras), ""))
+    try:
+        if not pipeline.config.ground_truth_perception:
+            timed("render", station.outputs[f"{camera}.depth_image"])
+        stages.scene = timed("perception", pipeline.ports["scene_description"])
+        if rgb and camera in station.cameras:
+            port = station.outputs[f"{camera}.rgb_image"]
+            stages.rgb = np.array(port.Eval(port.get_system().GetMyContextFromRoot(context))
+                                  .data[:, :, :3])
+        if stages.scene.target is None:
+            return stages
+        stages.prior = timed("kernel_prior", pipeline.ports["category_prior"])
+        stages.semantics = timed("logic", pipeline.ports["grasp_semantics"])
+        stages.ranked = timed("dgi_scoring", pipeline.ports["ranked_grasps"])
+    except TgDrakeError:
+        pass
+    return stages
+
+
+def final_stages(pipeline, context, stages: Stages, outcome) -> Stages:
+    """The logic's and the scorer's values the planner used last: after re-queries the ones at
+    the end of the run (the collision evidence changed them), else those of the start."""
+    if not outcome.requeries or stages.semantics is None:
+        return stages
+    final = Stages(scene=stages.scene, prior=stages.prior, rgb=stages.rgb,
+                   warnings=list(stages.warnings))
+    try:
+        for name in ("semantics", "ranked"):
+            port = pipeline.ports["grasp_semantics" if name == "semantics" else "ranked_grasps"]
+            setattr(final, name, port.Eval(port.get_system().GetMyContextFromRoot(context)))
+    except TgDrakeError as e:
+        final.semantics, final.ranked = stages.semantics, stages.ranked
+        final.warnings.append(f"the stages after the re-queries could not be evaluated ({e}); "
+                              "category, task, part and grasp scores are those of the start")
+    return final
+
+
+def result_of(*, scenario, scenario_path: str, stages: Stages, outcome, plan_status,
+              timings: dict) -> dict:
+    """The result.json dictionary (its keys: docs of `tg_drake.run`)."""
+    result: dict = {"scenario": scenario_path, "task_given": scenario.task.task or None,
+                    "perception": {"n_objects": 0, "target": None}}
+    if stages.scene is not None:
+        result["perception"] = _perception_json(stages.scene)
+    if stages.prior is not None:
+        result["category_prior"] = _distribution(
+            stages.prior.distributions[stages.scene.target].as_dict())
+    if stages.semantics is not None:
+        result.update(_semantics_json(stages.semantics))
+        result["collisions"] = list(outcome.unreachable_parts)  # the evidence last given
+        result["grasp_probability"] = round(float(stages.semantics.grasp_probability), 6)
+    if stages.ranked is not None:
+        result["n_hypotheses"] = int(len(stages.ranked.score))
+    if plan_status is not None and plan_status.attempt > 0:
+        timings["planning"] = plan_status.planning_time
+        result["planning"] = {"status": plan_status.status.value, "attempt": plan_status.attempt,
+                              "part": plan_status.part,
+                              "unreachable_parts": list(outcome.unreachable_parts),
+                              "requeries": outcome.requeries, "reason": plan_status.reason}
+        if plan_status.plan is not None:
+            i = plan_status.candidate
+            ranked = stages.ranked
+            known = ranked is not None and i is not None and i < len(ranked.score)
+            result["grasp"] = {**_xyz_rpy(plan_status.X_WG), "part": plan_status.part,
+                               "p_part": float(ranked.p_part[i]) if known else None,
+                               "p_local": float(ranked.p_local[i]) if known else None,
+                               "score": float(ranked.score[i]) if known else None}
+    result["outcome"] = outcome.as_dict()
+    if stages.warnings:
+        result["warnings"] = list(stages.warnings)
+    result["timings"] = {k: round(v, 4) for k, v in timings.items()}
+    result["config"] = yaml_load(data=yaml_dump_typed(scenario))  # the full resolved scenario
+    return result
+
+
+@dataclass
+class Pictures:
+    """What the pictures are drawn from."""
+
+    stages: Stages
+    X_WG: np.ndarray | None = None  # the chosen grasp pose, if a plan was made
+
+
+def write(folder: Path, result: dict, pictures: Pictures | None) -> list[str]:
+    """Writes result.json, then the pictures; returns (and prints to stderr) the warnings of the
+    pictures that could not be drawn."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "result.json").write_text(json.dumps(result, indent=2) + "\n")
+    if pictures is None:
+        return []
+    warnings = []
+    stages = pictures.stages
+    seed = int(result.get("config", {}).get("random_seed", 0))  # which points are drawn
+    jobs = []
+    if stages.rgb is not None:
+        jobs.append(("camera.png", lambda: _save_rgb(stages.rgb, folder / "camera.png")))
+    if stages.scene is not None and stages.scene.objects:
+        jobs.append(("parts.png", lambda: save_scene_png(stages.scene.objects,
+                                                         folder / "parts.png", seed=seed)))
+    if pictures.X_WG is not None and stages.scene is not None and "grasp" in result:
+        target = stages.scene.objects[stages.scene.target]
+        jobs.append(("grasp.png", lambda: save_grasp_png(target, pictures.X_WG,
+                                                         folder / "grasp.png",
+                                                         title=_grasp_title(result),
+                                                         seed=seed)))
+    for name, job in jobs:
+        try:
+            job()
+        except Exception as e:  # a picture is never worth the result
+            warnings.append(f"{name} not written: {type(e).__name__}: {e}")
+            print(f"warning: {warnings[-1]}", file=sys.stderr)
+    return warnings
+
+
+def _save_rgb(rgb: np.ndarray, path: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    plt.imsave(path, rgb)
+
+
+def _distribution(d: dict) -> dict:
+    return {k: round(float(v), 6) for k, v in sorted(d.items(), key=lambda kv: -kv[1])}
+
+
+def _xyz_rpy(X) -> dict:
+    X = X if isinstance(X, RigidTransform) else RigidTransform(np.asarray(X))
+    return {"xyz": [round(float(v), 5) for v in X.translation()],
+            "rpy": [round(float(v), 5) for v in RollPitchYaw(X.rotation()).vector()]}
+
+
+def _perception_json(scene) -> dict:
+    if scene.target is None:
+        return {"n_objects": len(scene.objects), "target": None}
+    obj = scene.objects[scene.target]
+    return {"n_objects": len(scene.objects), "target": scene.target, "pose": obj.pose,
+            "pose_likelihood": _distribution(obj.pose_likelihood),
+            "parts": _distribution(obj.part_probabilities),
+            "extents": [round(float(v), 4) for v in obj.extents],
+            "n_points": int(len(obj.p_W))}
+
+
+def _semantics_json(semantics) -> dict:
+    out = {"category": _distribution(semantics.category), "task": _distribution(semantics.task),
+           "part": _distribution(semantics.part), "collisions": list(semantics.collisions)}
+    out["explanations"] = {
+        query: [{"answer": e.answer, "probability": round(float(e.probability), 6),
+                 "reasons": [[r, round(float(w), 6)] for r, w in e.reasons[:5]]}
+                for e in explanations]
+        for query, explanations in semantics.explanations.items()}
+    return out
+
+
+# The open WSG's finger pads in G and its body box, for the grasp picture (tg_drake.robot).
+_PADS_G = robot.wsg_pad_boxes()
+_BODY_G = (robot.WSG_BODY_CENTRE_G, robot.WSG_BODY_SIZE)
+
+
+def _box_edges(X_WG: np.ndarray, centre, size) -> list[np.ndarray]:
+    """The 12 edges of a box given in G, as (2, 3) world segments."""
+    c, h = np.asarray(centre), np.asarray(size) / 2
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * h + c
+    corners_W = corners @ X_WG[:3, :3].T + X_WG[:3, 3]
+    return [corners_W[[i, j]] for i in range(8) for j in range(i + 1, 8)
+            if np.sum(np.abs(np.sign(corners[i] - c) - np.sign(corners[j] - c))) == 2]
+
+
+def save_grasp_png(obj, X_WG: np.ndarray, path: Path, *, title: str = "", seed: int = 0) -> Path:
+    """The target's part-coloured cloud in the world with the chosen gripper pose drawn as boxes
+    (finger pads black, body grey) and its approach direction."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+
+    X_WG = np.asarray(X_WG, float)
+    fig = plt.figure(figsize=(5, 5))
+    ax = fig.add_subplot(projection="3d")
+    idx = np.random.default_rng(seed).permutation(len(obj.p_W))[:5000]
+    ax.scatter(*obj.p_W[idx].T, c=np.asarray(PART_COLORS)[obj.labels[idx]], s=2,
+               depthshade=False, linewidths=0)
+    for centre, size in _PADS_G:
+        for e in _box_edges(X_WG, centre, size):
+            ax.plot(*e.T, color="black", linewidth=1.2)
+    for e in _box_edges(X_WG, *_BODY_G):
+        ax.plot(*e.T, color="0.5", linewidth=0.8)
+    grasp_point = X_WG[:3, 3] + X_WG[:3, :3] @ robot.WSG_GRASP_POINT_G
+    ax.quiver(*(grasp_point - 0.12 * X_WG[:3, 1]), *(0.08 * X_WG[:3, 1]), color="black")
+    centre = obj.X_WO[:3, 3]
+    half = max(0.5 * float(np.max(obj.extents)), 0.12)
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(max(centre[2] - half, -0.01), centre[2] + 2 * half)
+    ax.set_box_aspect((1, 1, 1.5))
+    ax.set_xlabel("x_W [m]")
+    ax.set_ylabel("y_W [m]")
+    ax.set_zlabel("z_W [m]")
+    ax.set_title(title, fontsize=8)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def _grasp_title(result: dict) -> str:
+    g = result["grasp"]
+    if g["score"] is None:
+        return f"grasp on {g['part']}\noutcome: {result['outcome']['status']}"
+    return (f"grasp on {g['part']}: score {g['score']:.2f} = P(part|task) {g['p_part']:.2f} × "
+            f"P(grasp|shape) {g['p_local']:.2f}\noutcome: {result['outcome']['status']}")
+
+
+def summary(result: dict) -> str:
+    """The one-screen summary printed after a run."""
+    def top(d, n=4):
+        return ", ".join(f"{k} {v:.2f}" for k, v in list(d.items())[:n]) if d else "-"
+    o = result["outcome"]
+    lines = [f"scenario   {result['scenario']}"]
+    if "perception" in result and result["perception"].get("pose"):
+        p = result["perception"]
+        lines.append(f"perceived  {p['n_objects']} object(s); target pose {p['pose']}, parts "
+                     f"{top(p['parts'], 5)}")
+    for key in ("category_prior", "category", "task", "part"):
+        if key in result:
+            lines.append(f"{key:<10} {top(result[key])}")
+    if "grasp" in result and result["grasp"]["score"] is not None:
+        g = result["grasp"]
+        lines.append(f"grasp      part {g['part']}, xyz {g['xyz']}, score {g['score']:.3f} "
+                     f"(P(part|task) {g['p_part']:.2f} × P(grasp|shape) {g['p_local']:.2f})")
+    status = o["status"] + (f" ({o['reason']})" if o["reason"] else "")
+    lines.append(f"outcome    {status}: {o['detail']}")
+    if o["unreachable_parts"]:
+        lines.append(f"closed loop: unreachable parts {o['unreachable_parts']} became "
+                     f"collision evidence; {o['requeries']} re-quer{'y' if o['requeries'] == 1 else 'ies'}")
+    t = result["timings"]
+    lines.append("timings    " + ", ".join(f"{k} {v:.2f}s" for k, v in t.items()
+                                          if k != "simulated_time"))
+    for w in result.get("warnings", []):
+        lines.append(f"warning    {w}")
+    return "\n".join(lines)

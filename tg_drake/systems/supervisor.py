@@ -1,0 +1,420 @@
+"""The closed loop's one owner: the logic's veto, the re-query policy, waiting for plans and the
+execution monitor, with the run's `Outcome` on an output port.
+
+A composed diagram (`tg_drake.diagram.add_pipeline`) and `tg-drake run` behave the same because
+every decision that spans stages is taken here, in simulated time, from port values:
+
+1. **Gate** (at `SupervisorConfig.planning_start`, and again after every re-query): perception
+   saw an object at the target; the logic does not rule grasping out (P(some part is grasped) ≥
+   `min_grasp_probability`, some part with non-zero probability); some pre-grasp hypothesis has a
+   non-zero score. Then the planner is asked for a plan (``plan_request``, attempt n).
+2. **Re-query**: a failed attempt whose part has no pickable candidate makes that part
+   `collision(Part)` evidence on ``collisions`` (read by the logic); after at most
+   `max_requeries` re-queries, or when no part is blamed, the run fails as "unreachable", with the
+   first failure's reason kept in the detail.
+3. **Monitor**: at the plan's key times (the first check at or after each): both pads hold the
+   object when the gripper has closed (else "missed"), the object rose with the gripper during the
+   lift (else "slipped"), and at the end it stands let go at the place target (else "lifted").
+"""
+
+
+import dataclasses
+import enum
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.math import RigidTransform
+from pydrake.multibody.plant import ContactResults
+from pydrake.systems.framework import EventStatus, LeafSystem
+
+from tg_drake.errors import (GraspingError, KernelError, PerceptionError, PlanningError,
+                             RuleError, SimulationError, TgDrakeError)
+from tg_drake.scenario import SupervisorConfig
+from tg_drake.outcome import HandGeometries, hand_contact, placed, touches_table
+from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
+from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
+
+
+class Status(str, enum.Enum):
+    """``Outcome.status`` (compares equal to its value)."""
+
+    pending = "pending"  # not final yet
+    placed = "placed"
+    lifted = "lifted"
+    grasped = "grasped"
+    failed = "failed"
+
+
+class Reason(str, enum.Enum):
+    """``Outcome.reason``: why a run failed or fell short of placing ("" when placed)."""
+
+    none = ""
+    unreachable = "unreachable"
+    perception = "perception"
+    logic = "logic"
+    slipped = "slipped"
+    missed = "missed"
+    collision = "collision"
+    simulation = "simulation"
+    timeout = "timeout"
+
+
+OUTCOME_STATUSES = tuple(s.value for s in Status if s is not Status.pending)  # final statuses
+FAILURE_REASONS = tuple(r.value for r in Reason if r is not Reason.none)
+
+# The failure reason a stage's error stands for.
+REASON_OF_ERROR = ((PerceptionError, Reason.perception), (KernelError, Reason.perception),
+                   (RuleError, Reason.logic), (GraspingError, Reason.logic),
+                   (PlanningError, Reason.unreachable), (SimulationError, Reason.simulation))
+
+
+def reason_of(error: TgDrakeError) -> Reason:
+    return next((r for cls, r in REASON_OF_ERROR if isinstance(error, cls)), Reason.simulation)
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """Value of the ``outcome`` output: what the run came to, final once `final` is True."""
+
+    status: Status = Status.pending
+    reason: Reason = Reason.none  # for "failed" or a partial success; none when placed
+    detail: str = ""  # a human-readable explanation (while pending: what the supervisor waits for)
+    reachable_parts: tuple = ()  # the part a plan was made for
+    unreachable_parts: tuple = ()  # parts given to the logic as collision(Part) evidence
+    requeries: int = 0  # how often the logic was asked again with new collision evidence
+
+    @property
+    def final(self) -> bool:
+        return self.status is not Status.pending
+
+    def as_dict(self) -> dict:
+        """The JSON form (result.json's ``outcome``)."""
+        return {"status": self.status.value, "reason": self.reason.value, "detail": self.detail,
+                "reachable_parts": list(self.reachable_parts),
+                "unreachable_parts": list(self.unreachable_parts), "requeries": self.requeries}
+
+
+def outcome_of_error(error: Exception, *, pending: Outcome | None = None) -> Outcome:
+    """The failed outcome of an error raised while simulating (a stage's TgDrakeError, or a
+    RuntimeError of the simulation itself), keeping the closed loop's parts and count."""
+    pending = pending or Outcome()
+    if isinstance(error, TgDrakeError):
+        reason, detail = reason_of(error), str(error)
+    else:
+        reason, detail = Reason.simulation, f"the simulation failed: {error}"
+    return dataclasses.replace(pending, status=Status.failed, reason=reason, detail=detail)
+
+
+@dataclass(frozen=True)
+class MonitorModel:
+    """What the execution monitor needs to know about the plant's model (read once, before
+    simulating): the geometry ids of the target, fingers and table, the indices of the target's
+    and the gripper's bodies in ``body_poses``, and the target's box centre in its frame [m]."""
+
+    geometries: HandGeometries
+    object_body: int
+    gripper_body: int
+    p_OC: tuple = (0.0, 0.0, 0.0)
+
+    @classmethod
+    def from_plant(cls, plant, *, object_body, wsg_instance, table_instance,
+                   p_OC=(0.0, 0.0, 0.0)) -> "MonitorModel":
+        return cls(HandGeometries.from_plant(plant, object_body=object_body,
+                                             wsg_instance=wsg_instance,
+                                             table_instance=table_instance),
+                   int(object_body.index()), int(plant.GetBodyByName("body", wsg_instance).index()),
+                   tuple(float(v) for v in p_OC))
+
+
+class Phase(str, enum.Enum):
+    gate = "gate"  # the next check runs the gate (at the start, and after a re-query)
+    planning = "planning"  # waiting for the planner's answer to the current attempt
+    executing = "executing"  # following the plan, monitoring its key times
+    done = "done"  # the outcome is final
+
+
+@dataclass(frozen=True)
+class _Memory:
+    """The supervisor's abstract state. Immutable: updates replace it."""
+
+    phase: Phase = Phase.gate
+    attempt: int = 0  # the last plan attempt requested
+    collisions: tuple = ()  # parts given to the logic as collision(Part) evidence
+    requeries: int = 0
+    failures: tuple = ()  # (part or None, reason) of every failed attempt, in order
+    status: PlanStatus | None = None  # the planner's answer with the plan being executed
+    checks_passed: int = 0  # execution checks passed: 1 grasp closed, 2 lift done
+    z_G_grasped: float = 0.0  # [m] gripper body height when the grasp closed
+    z_O_grasped: float = 0.0  # [m] object height when the grasp closed
+    X_WO_picked: RigidTransform | None = None  # object pose when the plan started
+    outcome: Outcome | None = None  # the final outcome
+
+    def __deepcopy__(self, memo):
+        return self  # immutable: the simulator's state copies may share it
+
+
+class Supervisor(LeafSystem):
+    """Gates, re-queries, waits for plans and monitors the execution; publishes the outcome.
+
+    .. pydrake_system::
+
+        name: Supervisor
+        input_ports:
+        - scene_description
+        - grasp_semantics
+        - ranked_grasps
+        - plan_status
+        - wsg.state
+        - body_poses
+        - contact_results
+        output_ports:
+        - collisions
+        - plan_request
+        - outcome
+
+    ``scene_description`` (`SceneDescription`), ``grasp_semantics`` (`GraspSemantics`) and
+    ``ranked_grasps`` (`GraspCandidates`) are read at gate checks only; ``plan_status``
+    (`PlanStatus`) while waiting for a plan; ``wsg.state`` (4: finger q, v), ``body_poses``
+    (world poses of the plant's bodies) and ``contact_results`` (`ContactResults`) at the plan's
+    key times only. A periodic unrestricted update every `SupervisorConfig.period` seconds from
+    `planning_start` moves through the phases gate → planning → executing → done (module doc);
+    a check that changes nothing leaves the state untouched. A stage's error raised during a gate
+    check (`TgDrakeError`) ends the run as failed with that stage's reason.
+
+    Outputs depend on the state only: ``collisions`` (tuple of part names, for the logic's
+    ``collisions`` input), ``plan_request`` (`PlanRequest`: the attempt to plan and the parts to
+    leave out, for the planner) and ``outcome`` (`Outcome`; `Outcome.final` once decided).
+    """
+
+    def __init__(self, *, config: SupervisorConfig | None = None, model: "MonitorModel"):
+        super().__init__()
+        self._config = config or SupervisorConfig()
+        self._config.validate()
+        self._model = model
+
+        self._scene_port = self.DeclareAbstractInputPort(
+            "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
+        self._semantics_port = self.DeclareAbstractInputPort(
+            "grasp_semantics", AbstractValue.Make(GraspSemantics({}, {}, {}, None)))
+        self._grasps_port = self.DeclareAbstractInputPort(
+            "ranked_grasps", AbstractValue.Make(GraspCandidates(
+                X_WG=np.zeros((0, 4, 4)), parts=np.zeros(0, int), p_part=np.zeros(0),
+                p_local=np.zeros(0), score=np.zeros(0))))
+        self._status_port = self.DeclareAbstractInputPort(
+            "plan_status", AbstractValue.Make(PlanStatus(PlanState.planning)))
+        self._wsg_port = self.DeclareVectorInputPort("wsg.state", 4)
+        self._poses_port = self.DeclareAbstractInputPort(
+            "body_poses", AbstractValue.Make([RigidTransform()]))
+        self._contacts_port = self.DeclareAbstractInputPort(
+            "contact_results", AbstractValue.Make(ContactResults()))
+
+        self._memory = self.DeclareAbstractState(AbstractValue.Make(_Memory()))
+        self.DeclarePeriodicUnrestrictedUpdateEvent(self._config.period,
+                                                    self._config.planning_start, self._check)
+
+        on_state = {self.abstract_state_ticket(self._memory)}
+        self._collisions_port = self.DeclareAbstractOutputPort(
+            "collisions", lambda: AbstractValue.Make(()), self._calc_collisions,
+            prerequisites_of_calc=on_state)
+        self._request_port = self.DeclareAbstractOutputPort(
+            "plan_request", lambda: AbstractValue.Make(PlanRequest()), self._calc_request,
+            prerequisites_of_calc=on_state)
+        self._outcome_port = self.DeclareAbstractOutputPort(
+            "outcome", lambda: AbstractValue.Make(Outcome()), self._calc_outcome,
+            prerequisites_of_calc=on_state)
+
+    @property
+    def config(self) -> SupervisorConfig:
+        return self._config
+
+    # Port accessors.
+    def get_scene_description_input_port(self):
+        return self._scene_port
+
+    def get_grasp_semantics_input_port(self):
+        return self._semantics_port
+
+    def get_ranked_grasps_input_port(self):
+        return self._grasps_port
+
+    def get_plan_status_input_port(self):
+        return self._status_port
+
+    def get_wsg_state_input_port(self):
+        return self._wsg_port
+
+    def get_body_poses_input_port(self):
+        return self._poses_port
+
+    def get_contact_results_input_port(self):
+        return self._contacts_port
+
+    def get_collisions_output_port(self):
+        return self._collisions_port
+
+    def get_plan_request_output_port(self):
+        return self._request_port
+
+    def get_outcome_output_port(self):
+        return self._outcome_port
+
+    # The periodic check.
+    def _check(self, context, state):
+        memory: _Memory = context.get_abstract_state(self._memory).get_value()
+        if memory.phase is Phase.done:
+            return EventStatus.DidNothing()
+        try:
+            if memory.phase is Phase.gate:
+                new = self._gate(context, memory)
+            elif memory.phase is Phase.planning:
+                new = self._await_plan(context, memory)
+            else:
+                new = self._monitor(context, memory)
+        except TgDrakeError as e:
+            new = self._finish(memory, Status.failed, reason_of(e), str(e))
+        if new is memory:
+            return EventStatus.DidNothing()
+        state.get_mutable_abstract_state(self._memory).set_value(new)
+        return EventStatus.Succeeded()
+
+    def _finish(self, memory: _Memory, status: Status, reason: Reason, detail: str,
+                **changes) -> _Memory:
+        memory = dataclasses.replace(memory, **changes)
+        reachable = (memory.status.part,) if memory.status is not None else ()
+        return dataclasses.replace(memory, phase=Phase.done, outcome=Outcome(
+            status, reason, detail, reachable_parts=reachable,
+            unreachable_parts=memory.collisions, requeries=memory.requeries))
+
+    def _gate(self, context, memory: _Memory) -> _Memory:
+        scene: SceneDescription = self._scene_port.Eval(context)
+        if not scene.objects:
+            return self._finish(memory, Status.failed, Reason.perception,
+                                "perception found no object on the table")
+        if scene.target is None:
+            return self._finish(memory, Status.failed, Reason.perception,
+                                "perception found no object at the target's position")
+        # After a re-query the logic answers with the collision evidence: a veto then comes
+        # from the parts found unreachable.
+        reason, told = Reason.logic, ""
+        if memory.collisions:
+            reason = Reason.unreachable
+            told = f", told {', '.join(memory.collisions)} cannot be reached"
+        semantics: GraspSemantics = self._semantics_port.Eval(context)
+        task = semantics.given_task or "inferred"
+        if not semantics.part or max(semantics.part.values()) <= 0:
+            return self._finish(memory, Status.failed, reason,
+                                f"the logic ruled every grasp out (task {task}{told})")
+        p, p_min = semantics.grasp_probability, self._config.min_grasp_probability
+        if p < p_min:
+            return self._finish(memory, Status.failed, reason,
+                                "the logic rules grasping out: P(some part is grasped) = "
+                                f"{p:.3f} < {p_min} (task {task}{told})")
+        grasps: GraspCandidates = self._grasps_port.Eval(context)
+        if len(grasps.score) == 0 or not np.any(np.asarray(grasps.score) > 0):
+            return self._finish(memory, Status.failed, reason,
+                                f"no pre-grasp hypothesis with a non-zero score{told}")
+        return dataclasses.replace(memory, phase=Phase.planning, attempt=memory.attempt + 1)
+
+    def _await_plan(self, context, memory: _Memory) -> _Memory:
+        status: PlanStatus = self._status_port.Eval(context)
+        if status.attempt >= memory.attempt and status.status in (PlanState.executing,
+                                                                  PlanState.done):
+            poses = self._poses_port.Eval(context)
+            return dataclasses.replace(memory, phase=Phase.executing, status=status,
+                                       X_WO_picked=poses[self._model.object_body])
+        if status.attempt >= memory.attempt and status.status is PlanState.failed:
+            return self._after_failure(memory, status)
+        deadline = self._config.planning_start + self._config.planning_timeout
+        if context.get_time() >= deadline:
+            return self._finish(memory, Status.failed, Reason.timeout,
+                                f"no plan within planning_timeout = "
+                                f"{self._config.planning_timeout} s (attempt {memory.attempt})")
+        return memory
+
+    def _after_failure(self, memory: _Memory, status: PlanStatus) -> _Memory:
+        failures = memory.failures + ((status.failed_part, status.reason),)
+        why = _why(failures)
+        new = tuple(p for p in status.unreachable_parts if p not in memory.collisions)
+        if not new:  # nothing new to tell the logic
+            return self._finish(memory, Status.failed, Reason.unreachable, why,
+                                failures=failures)
+        collisions = memory.collisions + new
+        if memory.requeries >= self._config.max_requeries:
+            return self._finish(memory, Status.failed, Reason.unreachable,
+                                f"gave up after {memory.requeries} re-queries; {why}",
+                                failures=failures, collisions=collisions)
+        return dataclasses.replace(memory, phase=Phase.gate, failures=failures,
+                                   collisions=collisions, requeries=memory.requeries + 1)
+
+    def _monitor(self, context, memory: _Memory) -> _Memory:
+        plan, t_plan = memory.status.plan, memory.status.t_plan
+        t = context.get_time() - t_plan
+        key_time = (plan.t_grasp_closed, plan.t_lift_done, plan.duration)[memory.checks_passed]
+        if t < key_time:
+            return memory
+        contacts = self._contacts_port.Eval(context)
+        hand = hand_contact(contacts, wsg_q=self._wsg_port.Eval(context)[:2],
+                            geometries=self._model.geometries)
+        poses = self._poses_port.Eval(context)
+        X_WO = poses[self._model.object_body]
+        z_G = poses[self._model.gripper_body].translation()[2]
+        if memory.checks_passed == 0:  # the gripper has closed
+            if not hand.held:
+                return self._finish(
+                    memory, Status.failed, Reason.missed,
+                    f"fingers closed to {hand.opening * 1000:.0f} mm without holding the object "
+                    f"(left pad {hand.left}, right pad {hand.right})")
+            return dataclasses.replace(memory, checks_passed=1, z_G_grasped=z_G,
+                                       z_O_grasped=X_WO.translation()[2])
+        if memory.checks_passed == 1:  # the lift is done
+            rise = X_WO.translation()[2] - memory.z_O_grasped
+            gripper_rise = z_G - memory.z_G_grasped
+            if not hand.held or rise < self._config.min_rise_ratio * gripper_rise:
+                return self._finish(memory, Status.grasped, Reason.slipped,
+                                    f"the object rose {rise * 100:.1f} cm while the gripper rose "
+                                    f"{gripper_rise * 100:.1f} cm")
+            return dataclasses.replace(memory, checks_passed=2)
+        # The plan is over: let go, the table carries the object (a pad may still brush it).
+        if not np.all(np.isfinite(X_WO.GetAsMatrix4())):
+            return self._finish(memory, Status.failed, Reason.simulation,
+                                "the simulation diverged")
+        on_table = touches_table(contacts, geometries=self._model.geometries)
+        ok, detail = placed(memory.X_WO_picked, X_WO, plan.X_WO_place[:2, 3],
+                            released=on_table and not hand.held, p_OC=self._model.p_OC)
+        if ok:
+            return self._finish(memory, Status.placed, Reason.none, detail)
+        return self._finish(memory, Status.lifted, Reason.slipped, detail)
+
+    # Outputs.
+    def _memory_of(self, context) -> _Memory:
+        return context.get_abstract_state(self._memory).get_value()
+
+    def _calc_collisions(self, context, output):
+        output.set_value(self._memory_of(context).collisions)
+
+    def _calc_request(self, context, output):
+        memory = self._memory_of(context)
+        output.set_value(PlanRequest(attempt=memory.attempt, exclude_parts=memory.collisions))
+
+    def _calc_outcome(self, context, output):
+        memory = self._memory_of(context)
+        if memory.outcome is not None:
+            output.set_value(memory.outcome)
+            return
+        waiting = {Phase.gate: "waiting for the gate check",
+                   Phase.planning: f"waiting for plan attempt {memory.attempt}",
+                   Phase.executing: f"executing the plan (checks passed: {memory.checks_passed})"}
+        output.set_value(Outcome(Status.pending, Reason.none, waiting[memory.phase],
+                                 unreachable_parts=memory.collisions,
+                                 requeries=memory.requeries))
+
+
+def _why(failures: tuple) -> str:
+    """The last failure's reason, with the first one's when they differ (the first is usually the
+    informative one: later attempts only find nothing left to try)."""
+    last = failures[-1][1]
+    first_part, first = failures[0]
+    if len(failures) == 1 or first == last:
+        return last
+    return f"{last} (first failure, {first_part or 'no part'}: {first})"
