@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import GRASP_POINT, grasp_pose
+from grasp_helpers import GRASP_POINT, grasp_pose
 from pydrake.math import RigidTransform, RotationMatrix
 
 from tg_drake.planning.ik import (CONSTRAINT_TOLERANCE, clearance, make_arm_plant,

@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 import pytest
-from conftest import grasp_pose
+from grasp_helpers import grasp_pose
 from pydrake.common.value import AbstractValue
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder

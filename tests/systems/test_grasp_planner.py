@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import grasp_pose
+from grasp_helpers import grasp_pose
 from pydrake.systems.analysis import Simulator
 
 from tg_drake.planning.planner import PlannerConfig

@@ -1,4 +1,5 @@
-"""Helpers shared by the tests: gripper poses built from a grasp point."""
+"""Helpers shared by the tests (importable as `grasp_helpers`: pyproject sets pythonpath): gripper
+poses built from a grasp point."""
 
 from __future__ import annotations
 
