@@ -122,7 +122,7 @@ def test_default_table_is_the_model_file():
     from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
     from pydrake.systems.framework import DiagramBuilder
 
-    from tg_drake.station import models_root
+    from tg_drake.models import models_root
 
     _, station = make_station(_scenario())
     builder = DiagramBuilder()
