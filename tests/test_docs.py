@@ -54,7 +54,7 @@ def test_no_tracked_file_refers_to_a_document_outside_the_repository():
 
 def test_the_check_finds_a_reference_outside(tmp_path):
     (tmp_path / "a.py").write_text('"""Wiring (' + OUTSIDE[0] + ', "The diagram")."""\n')
-    (tmp_path / "b.sdf").write_text("<!-- from\n     " + OUTSIDE[2] + "/robot_facts.md -->\n")
+    (tmp_path / "b.sdf").write_text("<!-- from\n     " + OUTSIDE[2] + "/" + OUTSIDE[1] + " -->\n")
     (tmp_path / "c.md").write_text("See docs/design.md.\n")
     (tmp_path / "d.bin").write_bytes(b"\0" + OUTSIDE[1].encode())
     found = references_outside(sorted(tmp_path.iterdir()))
