@@ -9,7 +9,7 @@ every system it added (`pipeline.perception`, `.prior`, `.logic`, `.scoring`, `.
 `.supervisor` and the `station`), so you can add systems of yours to the same builder and connect
 them to any port — or call `add_station` alone and wire only the stages you want.
 
-Wiring (DESIGN.md, "The diagram"):
+Wiring (docs/design.md, "The diagram"):
 
     station camera depth, camera pose ─▶ perception ─▶ target ─▶ scene_description
         (latched: perceived at initialization and on a new perception_request, never live)

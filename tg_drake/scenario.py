@@ -124,7 +124,8 @@ def default_drivers() -> dict[str, DriverConfig]:
 
 
 def default_plant_config() -> MultibodyPlantConfig:
-    # Settings measured to hold a grasp on this kind of machine (robot_facts.md).
+    # Settings measured to hold a grasp on this kind of machine (docs/design.md, "Simulation
+    # settings").
     return MultibodyPlantConfig(time_step=0.005, contact_model="hydroelastic_with_fallback",
                                 discrete_contact_approximation="sap")
 

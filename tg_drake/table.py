@@ -28,7 +28,7 @@ TABLE_HEIGHT = 0.4  # [m] table-top surface above the floor
 TABLE_MASS = 20.0  # [kg] of the top (welded to the world: it only fills the model)
 TABLE_LEG_WIDTH = 0.05  # [m] square legs
 TABLE_LEG_INSET = 0.05  # [m] from a top edge to a leg's centre line
-# The compliant top, measured to hold objects at rest on this kind of machine (robot_facts.md):
+# The compliant top, measured to hold objects at rest (docs/design.md, "Simulation settings"):
 # hydroelastic modulus [Pa], mesh resolution hint [m], Hunt–Crossley dissipation [s/m], friction.
 TABLE_HYDRO = dict(modulus=1e7, resolution=0.1, dissipation=3.0, mu=0.5)
 MIN_TABLE_SIZE = 2 * TABLE_LEG_INSET + TABLE_LEG_WIDTH  # [m] below this the legs stick out
@@ -59,7 +59,7 @@ def table_sdf(size=TABLE_SIZE) -> str:
         '<?xml version="1.0"?>\n'
         "<!-- Table, written by tools/make_robot_models.py. Frame `table_top`: origin at the "
         "centre of\n"
-        "     the top surface, z up. The top is a compliant-hydroelastic box (robot_facts.md);\n"
+        "     the top surface, z up. The top is a compliant-hydroelastic box;\n"
         "     the legs are visual only. Weld `table_top` to the world. Do not edit by hand. -->\n"
         '<sdf version="1.9" xmlns:drake="http://drake.mit.edu">\n'
         '  <model name="table">\n'

@@ -78,8 +78,8 @@ def _geometry_urdf(shape) -> str:
 def iiwa_urdf() -> str:
     out = ['<?xml version="1.0"?>',
            "<!-- KUKA LBR iiwa 14 R820, written by tools/make_robot_models.py from",
-           "     ../shared/robot_facts.md: 7 revolute joints about their local z axes, primitive",
-           "     collision cylinders. Do not edit by hand. -->",
+           "     the figures of tg_drake/robot.py (KUKA's data sheet): 7 revolute joints about",
+           "     their local z axes, primitive collision cylinders. Do not edit by hand. -->",
            '<robot name="iiwa14" xmlns:drake="http://drake.mit.edu">',
            '  <material name="iiwa_orange"><color rgba="' + IIWA_ORANGE + '"/></material>',
            '  <material name="iiwa_grey"><color rgba="0.4 0.4 0.4 1"/></material>']
@@ -181,9 +181,9 @@ def wsg_sdf() -> str:
     return (
         '<?xml version="1.0"?>\n'
         "<!-- Schunk WSG 50 parallel gripper, written by tools/make_robot_models.py from\n"
-        "     ../shared/robot_facts.md. Frame of `body` (G): fingers close along ±x, the approach\n"
-        f"     direction is +y, the grasp point is {WSG_PAD_CENTRE_Y} m along +y. Finger pads are "
-        "plain boxes with\n"
+        "     the figures of tg_drake/robot.py (the WSG 50 data sheet). Frame of `body` (G):\n"
+        "     fingers close along ±x, the approach direction is +y, the grasp point is\n"
+        f"     {WSG_PAD_CENTRE_Y} m along +y. Finger pads are plain boxes with\n"
         "     compliant-hydroelastic properties. The two prismatic finger joints are the model's only\n"
         "     actuated joints (pydrake's SchunkWsgPositionController expects exactly that).\n"
         "     Do not edit by hand. -->\n"

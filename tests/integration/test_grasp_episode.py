@@ -1,7 +1,7 @@
 """One grasp in hydroelastic physics: the free-floating WSG 50 closes, lifts and shakes.
 
-The object is the cylinder of robot_facts.md (r 0.033 m, h 0.1 m, 0.3 kg), rigid hydroelastic with
-friction 1.0, standing upright on the table.
+The object is the cylinder the simulation settings were measured with (r 0.033 m, h 0.1 m,
+0.3 kg; docs/design.md), rigid hydroelastic with friction 1.0, standing upright on the table.
 """
 
 import numpy as np

@@ -1,6 +1,6 @@
 """Every library object, put on a table in each pose that suits it, stays put.
 
-Each case builds a MultibodyPlant with the table top of robot_facts.md (a box, compliant
+Each case builds a MultibodyPlant with the table top of tg_drake/table.py (a box, compliant
 hydroelastic: modulus 1e7 Pa, resolution hint 0.1 m, Hunt–Crossley dissipation 3 s/m, friction 0.5)
 and the object's SDF (rigid hydroelastic mesh, friction 1.0), places the object at X_WO = X_WT · X_TO
 from library.yaml and simulates 2 s with SAP. The object must not drift or tip, and its contact with

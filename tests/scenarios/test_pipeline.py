@@ -29,7 +29,7 @@ def run(name: str, **changes) -> dict:
 
 
 def check_result_keys(result: dict) -> None:
-    """result.json holds the keys DESIGN.md documents, with values of the documented kinds."""
+    """result.json holds the keys docs/design.md documents, with values of the documented kinds."""
     for key in ("scenario", "perception", "outcome", "timings"):
         assert key in result, key
     outcome = result["outcome"]

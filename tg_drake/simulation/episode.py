@@ -10,7 +10,7 @@ three revolute — on a frame F welded to the world at the grasp pose X_WG. The 
 measure the gripper's displacement from the grasp pose, expressed in the grasp frame, and are zero
 at the grasp; no parametrisation singularity occurs for any grasp orientation. Every joint is
 PD-controlled through its JointActuator gains with the desired state on the plant's
-`desired_state` input port (implicit in SAP, robot_facts.md); gravity is off for the gripper's
+`desired_state` input port (implicit in SAP); gravity is off for the gripper's
 bodies, which stand in for an arm that compensates it.
 
 An episode (all times in seconds, `EpisodeConfig`):
@@ -67,7 +67,7 @@ CARRIER_JOINTS = ("carrier_x", "carrier_y", "carrier_z", "carrier_rx", "carrier_
 class EpisodeConfig:
     """The physics and the script of one grasp episode."""
 
-    time_step: float = 0.005  # discrete plant step [s] (robot_facts: 2–10 ms held a grasp).
+    time_step: float = 0.005  # discrete plant step [s] (2–10 ms held a grasp: docs/design.md).
     approach_distance: float = 0.05  # start this far back along −y_G [m].
     approach_time: float = 0.15  # [s]
     close_time: float = 0.3  # [s]
@@ -78,7 +78,7 @@ class EpisodeConfig:
     shake_angle: float = 0.15  # amplitude of the rotation about z_G [rad].
     shake_cycles: float = 1.5  # full periods within shake_time.
     grip_force: float = 60.0  # set-point force of each finger [N] (the effort limit is 80 N).
-    finger_kp: float = 2000.0  # finger PD gains [N/m], [N·s/m] (robot_facts).
+    finger_kp: float = 2000.0  # finger PD gains [N/m], [N·s/m] (as the station's WSG driver).
     finger_kd: float = 50.0
     carrier_kp_translation: float = 2.0e5  # [N/m]: 0.06 mm sag under a 1.2 kg object's weight.
     carrier_kd_translation: float = 2.0e3  # [N·s/m]: well damped for the 1.1 kg gripper.
