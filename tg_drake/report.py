@@ -55,6 +55,11 @@ def evaluate_stages(pipeline, context, timings: dict, *, rgb: bool = False) -> S
         if not pipeline.config.ground_truth_perception:
             timed("render", station.outputs[f"{camera}.depth_image"])
         stages.scene = timed("perception", pipeline.ports["scene_description"])
+        # Perception ran in the initialization event (latched): its own wall time says what it
+        # cost, the port read above only what reading the latched value did.
+        status_port = pipeline.perception.GetOutputPort("perception_status")
+        timings["perception"] = float(
+            status_port.Eval(pipeline.perception.GetMyContextFromRoot(context)).wall_time)
         if rgb and camera in station.cameras:
             port = station.outputs[f"{camera}.rgb_image"]
             stages.rgb = np.array(port.Eval(port.get_system().GetMyContextFromRoot(context))
@@ -161,6 +166,9 @@ def write(folder: Path, result: dict, pictures: Pictures | None) -> list[str]:
         except Exception as e:  # a picture is never worth the result
             warnings.append(f"{name} not written: {type(e).__name__}: {e}")
             print(f"warning: {warnings[-1]}", file=sys.stderr)
+    if warnings:  # the result is on disk already; now it says which pictures are missing
+        result["warnings"] = list(result.get("warnings", [])) + warnings
+        (folder / "result.json").write_text(json.dumps(result, indent=2) + "\n")
     return warnings
 
 

@@ -18,7 +18,17 @@ def test_a_failing_picture_is_a_warning_and_the_result_is_kept(tmp_path):
     broken = SceneDescription(objects=[object()], X_WT=np.eye(4), target=0)
     pictures = Pictures(Stages(scene=broken, rgb=np.zeros((4, 6, 3), np.uint8)), X_WG=np.eye(4))
     warnings = write(tmp_path, result, pictures)
-    assert json.loads((tmp_path / "result.json").read_text()) == result
+    written = json.loads((tmp_path / "result.json").read_text())
+    assert written.pop("warnings") == warnings
+    assert written == {k: v for k, v in result.items() if k != "warnings"}
     assert (tmp_path / "camera.png").is_file()
     assert sorted(w.split()[0] for w in warnings) == ["grasp.png", "parts.png"]
     assert not (tmp_path / "parts.png").exists()
+
+
+def test_the_missing_pictures_are_named_in_the_result(tmp_path):
+    result = {"scenario": "x", "outcome": {"status": "placed", "reason": "", "detail": ""}}
+    broken = SceneDescription(objects=[object()], X_WT=np.eye(4), target=0)
+    write(tmp_path, result, Pictures(Stages(scene=broken)))
+    written = json.loads((tmp_path / "result.json").read_text())
+    assert [w.split()[0] for w in written["warnings"]] == ["parts.png"]

@@ -139,3 +139,45 @@ def test_a_short_simulation_ends_as_timeout():
     assert (result["outcome"]["status"], result["outcome"]["reason"]) == ("failed", "timeout")
     assert result["timings"]["simulated_time"] == pytest.approx(0.5, abs=1e-9)
     assert result["config"]["simulation_duration"] == 0.5
+
+
+def _plan_of(scenario):
+    """The plan the planner makes for `scenario` (simulated just past the first attempt)."""
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+
+    from tg_drake.diagram import add_pipeline
+
+    builder = DiagramBuilder()
+    pipeline = add_pipeline(builder, scenario=scenario)
+    simulator = Simulator(builder.Build())
+    context = simulator.get_mutable_context()
+    simulator.AdvanceTo(scenario.pipeline.supervisor.planning_start + 0.05)
+    status = pipeline.ports["plan_status"].Eval(pipeline.planner.GetMyContextFromRoot(context))
+    assert status.plan is not None, status.reason
+    return status.plan
+
+
+def test_a_planner_field_set_in_yaml_is_recorded_and_changes_the_plan(tmp_path):
+    from pydrake.common.yaml import yaml_dump_typed, yaml_load
+
+    from tg_drake.planning.ik import make_arm_plant
+
+    path = tmp_path / "lift.yaml"
+    path.write_text((SCENARIOS / "default.yaml").read_text()
+                    + "pipeline:\n  planner: {lift_height: 0.22}\n")
+    high = load_scenario(path)
+    assert yaml_load(data=yaml_dump_typed(high))["pipeline"]["planner"]["lift_height"] == 0.22
+    plans = {h: _plan_of(s) for h, s in ((0.15, load_scenario(SCENARIOS / "default.yaml")),
+                                          (0.22, high))}
+    # The gripper's height at the end of the lift, from the planned joint positions.
+    arm = make_arm_plant()
+    rise = {}
+    for h, plan in plans.items():
+        z = []
+        for t in (plan.t_grasp_closed, plan.t_lift_done):
+            arm.plant.SetPositions(arm.plant_context, arm.iiwa, plan.q(t))
+            z.append(arm.G.CalcPoseInWorld(arm.plant_context).translation()[2])
+        rise[h] = z[1] - z[0]
+    assert rise[0.15] == pytest.approx(0.15, abs=0.01)  # [m] IK position tolerance and the tilt
+    assert rise[0.22] == pytest.approx(0.22, abs=0.01)

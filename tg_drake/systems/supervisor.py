@@ -55,7 +55,6 @@ class Reason(str, enum.Enum):
     logic = "logic"
     slipped = "slipped"
     missed = "missed"
-    collision = "collision"
     simulation = "simulation"
     timeout = "timeout"
 
