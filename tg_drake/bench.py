@@ -10,9 +10,9 @@ import importlib
 import json
 import statistics
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Callable
 
 HELP = "measure the speed figures (JSON of medians and ratios against references)"
 

@@ -21,7 +21,6 @@ from pathlib import Path
 
 import numpy as np
 import yaml
-from scipy.spatial import ConvexHull
 from pydrake.common.schema import Transform
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
@@ -29,6 +28,7 @@ from pydrake.multibody.parsing import ModelDirective
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.sensors import CameraConfig
+from scipy.spatial import ConvexHull
 
 from tg_drake.errors import RuleError, ScenarioError, unknown_name
 from tg_drake.kernels.database import SOURCES as KERNEL_SOURCES
@@ -42,7 +42,6 @@ from tg_drake.robot_plants import default_directives
 from tg_drake.schema_check import SchemaError, check_document, load_raw
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, table_size_problem
 from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
-
 
 # The WSG body frame G on the iiwa's link 7 (tg_drake.robot: the mount).
 X_7G = RigidTransform(RollPitchYaw(*X_7G_RPY), X_7G_XYZ)

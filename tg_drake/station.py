@@ -32,14 +32,29 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.geometry import MakeRenderEngineGl, RenderEngineGlParams, SceneGraph, kHasRenderEngineGl
+from pydrake.geometry import (
+    MakeRenderEngineGl,
+    RenderEngineGlParams,
+    SceneGraph,
+    kHasRenderEngineGl,
+)
 from pydrake.lcm import DrakeLcm
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
-from pydrake.multibody.parsing import (AddModel, ModelDirective, ModelDirectives, Parser,
-                                       ProcessModelDirectives)
+from pydrake.multibody.parsing import (
+    AddModel,
+    ModelDirective,
+    ModelDirectives,
+    Parser,
+    ProcessModelDirectives,
+)
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
-from pydrake.multibody.tree import (JointActuatorIndex, ModelInstanceIndex, PdControllerGains, SpatialInertia,
-                                    UnitInertia)
+from pydrake.multibody.tree import (
+    JointActuatorIndex,
+    ModelInstanceIndex,
+    PdControllerGains,
+    SpatialInertia,
+    UnitInertia,
+)
 from pydrake.systems.controllers import InverseDynamicsController
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import MatrixGain
@@ -50,8 +65,13 @@ from tg_drake.models import make_parser
 from tg_drake.objects import get_object
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
 from tg_drake.robot_plants import add_scenario_models
-from tg_drake.scenario import (InverseDynamicsDriver, JointPdDriver, ObjectPlacement, Scenario,
-                               WsgPdDriver)
+from tg_drake.scenario import (
+    InverseDynamicsDriver,
+    JointPdDriver,
+    ObjectPlacement,
+    Scenario,
+    WsgPdDriver,
+)
 from tg_drake.table import add_table
 
 WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container

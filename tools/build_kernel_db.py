@@ -37,10 +37,16 @@ import numpy as np
 
 from tg_drake.errors import KernelError
 from tg_drake.kernels.database import ENTRIES, KernelDatabase, prepare_cloud
-from tg_drake.kernels.graph import K_NEIGHBOURS
 from tg_drake.kernels.evaluation import query_outcomes
+from tg_drake.kernels.graph import K_NEIGHBOURS
 from tg_drake.kernels.library import (
-    SPACING, VIEW_YAWS_DEG, VIEWPOINTS, library_clouds, library_fingerprint, perceived_views)
+    SPACING,
+    VIEW_YAWS_DEG,
+    VIEWPOINTS,
+    library_clouds,
+    library_fingerprint,
+    perceived_views,
+)
 from tg_drake.kernels.propagation import BIN_WIDTH, T_MAX, LshProjections
 from tg_drake.types import CATEGORIES
 

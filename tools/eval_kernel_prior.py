@@ -41,8 +41,15 @@ import numpy as np
 from tg_drake.evaluation.paper import PAPER
 from tg_drake.kernels.database import ENTRIES, KernelDatabase, load_database
 from tg_drake.kernels.evaluation import (
-    QUERY_YAWS_DEG, Score, best, evaluate_members, leave_one_object_out,
-    nested_leave_one_object_out, perceived_queries, random_score)
+    QUERY_YAWS_DEG,
+    Score,
+    best,
+    evaluate_members,
+    leave_one_object_out,
+    nested_leave_one_object_out,
+    perceived_queries,
+    random_score,
+)
 from tg_drake.kernels.graph import cloud_transition
 from tg_drake.kernels.library import SPACING, VIEWPOINTS, library_clouds, sample_object
 from tg_drake.kernels.propagation import T_MAX, LshProjections, graph_features, normalise

@@ -18,10 +18,22 @@ import sys
 import tempfile
 from pathlib import Path
 
-from tg_drake.robot import (IIWA_FLANGE_Z, IIWA_JOINTS, WSG_BODY, WSG_BODY_CENTRE_G, WSG_BODY_MASS,
-                            WSG_BODY_SIZE, WSG_FINGER_JOINTS, WSG_FINGER_MASS, WSG_FINGER_VELOCITY,
-                            WSG_FINGERS, WSG_FORCE_LIMIT, WSG_PAD_CENTRE_Y, WSG_PAD_SIZE,
-                            WSG_STROKE)
+from tg_drake.robot import (
+    IIWA_FLANGE_Z,
+    IIWA_JOINTS,
+    WSG_BODY,
+    WSG_BODY_CENTRE_G,
+    WSG_BODY_MASS,
+    WSG_BODY_SIZE,
+    WSG_FINGER_JOINTS,
+    WSG_FINGER_MASS,
+    WSG_FINGER_VELOCITY,
+    WSG_FINGERS,
+    WSG_FORCE_LIMIT,
+    WSG_PAD_CENTRE_Y,
+    WSG_PAD_SIZE,
+    WSG_STROKE,
+)
 from tg_drake.table import table_sdf
 
 MODELS = Path(__file__).resolve().parents[1] / "models"

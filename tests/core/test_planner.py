@@ -8,8 +8,7 @@ import pytest
 from conftest import GRASP_POINT, grasp_pose
 from pydrake.math import RigidTransform, RotationMatrix
 
-from tg_drake.planning.ik import (CONSTRAINT_TOLERANCE, clearance, make_arm_plant,
-                                  solve_ik_seeds)
+from tg_drake.planning.ik import CONSTRAINT_TOLERANCE, clearance, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.planner import PlannerConfig, place_pose, plan_pick_and_place
 from tg_drake.planning.trajectory import IIWA_VELOCITY_LIMITS
 from tg_drake.robot import IIWA_HOME

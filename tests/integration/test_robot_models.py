@@ -16,8 +16,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from tg_drake import robot
 from tg_drake.errors import ScenarioError
-from tg_drake.robot_plants import add_scenario_models, model_directives
-from tg_drake.robot_plants import default_directives
+from tg_drake.robot_plants import add_scenario_models, default_directives, model_directives
 from tg_drake.scenario import X_7G, Scenario
 
 ROOT = Path(__file__).resolve().parents[2]

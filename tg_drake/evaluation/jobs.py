@@ -55,7 +55,7 @@ PRIOR_FLOOR = 0.02  # the pipeline's (PipelineConfig.prior_floor): a prior that 
 CONFIDENT_PART = 0.5  # S_REAL: detected parts at least this likely are kept (as certain).
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _engine(category: str, grasp: str, exclusive: bool):
     return LogicEngine(TheoryConfig(category=category, grasp=grasp, exclusive=exclusive))
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tg_drake.evaluation.suite import DATASETS
 from tg_drake.evaluation.paper import PAPER
+from tg_drake.evaluation.suite import DATASETS
 from tg_drake.evaluation.tables import CATEGORY_METHODS, LABELS, THRESHOLDS
 
 DPI = 80  # small files for the repository

@@ -47,10 +47,21 @@ from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
-from tg_drake.planning.trajectory import (SegmentConfig, SegmentLimits, StraightLine,
-                                          plan_segment, shifted)
-from tg_drake.robot import (IIWA_HOME, WSG_FINGERTIP_Y, WSG_GRASP_POINT_G, WSG_MAX_OPENING,
-                            WSG_PAD_SIZE, WSG_PALM_Y)
+from tg_drake.planning.trajectory import (
+    SegmentConfig,
+    SegmentLimits,
+    StraightLine,
+    plan_segment,
+    shifted,
+)
+from tg_drake.robot import (
+    IIWA_HOME,
+    WSG_FINGERTIP_Y,
+    WSG_GRASP_POINT_G,
+    WSG_MAX_OPENING,
+    WSG_PAD_SIZE,
+    WSG_PALM_Y,
+)
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, SceneDescription
 
 

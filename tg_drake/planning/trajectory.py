@@ -29,9 +29,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.math import BsplineBasis, RigidTransform
-from pydrake.multibody.inverse_kinematics import (MinimumDistanceLowerBoundConstraint,
-                                                  OrientationConstraint,
-                                                  PointToLineDistanceConstraint)
+from pydrake.multibody.inverse_kinematics import (
+    MinimumDistanceLowerBoundConstraint,
+    OrientationConstraint,
+    PointToLineDistanceConstraint,
+)
 from pydrake.planning import KinematicTrajectoryOptimization
 from pydrake.solvers import Solve
 from pydrake.trajectories import BsplineTrajectory

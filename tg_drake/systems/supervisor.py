@@ -28,10 +28,17 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.plant import ContactResults
 from pydrake.systems.framework import EventStatus, LeafSystem
 
-from tg_drake.errors import (GraspingError, KernelError, PerceptionError, PlanningError,
-                             RuleError, SimulationError, TgDrakeError)
-from tg_drake.scenario import SupervisorConfig
+from tg_drake.errors import (
+    GraspingError,
+    KernelError,
+    PerceptionError,
+    PlanningError,
+    RuleError,
+    SimulationError,
+    TgDrakeError,
+)
 from tg_drake.outcome import HandGeometries, hand_contact, placed, touches_table
+from tg_drake.scenario import SupervisorConfig
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
