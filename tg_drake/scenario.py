@@ -15,7 +15,6 @@ library id, a pose label, a position on the table (in T) and a yaw about the tab
 
 import dataclasses
 import math
-import typing
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -115,7 +114,7 @@ class InverseDynamicsDriver:
     kd: float = 20.0  # [1/s]
 
 
-DriverConfig = typing.Union[JointPdDriver, WsgPdDriver, InverseDynamicsDriver]
+DriverConfig = JointPdDriver | WsgPdDriver | InverseDynamicsDriver
 
 
 def default_drivers() -> dict[str, DriverConfig]:
@@ -179,7 +178,7 @@ class GroundTruthPerception:
     spacing: float = 0.004  # [m] the meshes' surfaces are sampled this far apart
 
 
-PerceptionVariant = typing.Union[DepthPerception, GroundTruthPerception]
+PerceptionVariant = DepthPerception | GroundTruthPerception
 
 
 @dataclass
@@ -206,7 +205,7 @@ class OnePart:
     model: str = ""  # as DgiScorer.model
 
 
-ScoringVariant = typing.Union[DgiScorer, LocalOnly, OnePart]
+ScoringVariant = DgiScorer | LocalOnly | OnePart
 
 # The core's name (tg_drake.grasping.scoring.SELECTIONS) of each scoring variant.
 SELECTION_OF_SCORING = {DgiScorer: "pipeline", LocalOnly: "local_only", OnePart: "one_part"}
@@ -473,7 +472,7 @@ def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
     if isinstance(perception, DepthPerception) and perception.camera not in scenario.cameras:
         raise unknown_name("camera", perception.camera, list(scenario.cameras),
                            error=ScenarioError, file=where, field="pipeline.perception.camera")
-    for name, driver in scenario.model_drivers.items():
+    for name in scenario.model_drivers:
         if name not in ("iiwa", "wsg"):
             raise unknown_name("model driver", name, ["iiwa", "wsg"], error=ScenarioError,
                                file=where, field="model_drivers")

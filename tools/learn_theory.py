@@ -61,7 +61,7 @@ def split_objects(seed: int) -> dict[str, str]:
 
     rng = np.random.default_rng(seed)
     split = {}
-    for category, objects in library_by_category().items():
+    for objects in library_by_category().values():
         held_out = int(rng.integers(len(objects)))
         for i, obj in enumerate(objects):
             split[obj.id] = "test" if i == held_out else "train"

@@ -599,7 +599,7 @@ def summary_markdown(r: dict, ref: dict | None = None) -> list[str]:
             f"{v['best_by_cv_accuracy']}, reaches {100 * best['cv_accuracy']:.2f} %" + verdict]
         curve = v.get("learning_curve")
         if curve:
-            (f0, e0), (f1, e1) = list(curve.items())[1], list(curve.items())[-1]
+            e0, e1 = list(curve.values())[1], list(curve.values())[-1]
             lines += [
                 "- More grasps of the same kind: trained on half of them, the accuracy on unseen "
                 f"objects is {100 * e0['objectwise_accuracy']:.1f} %, on all "

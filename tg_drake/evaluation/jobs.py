@@ -89,7 +89,7 @@ def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS,
         prior = _prior(prior_kind, priors)
         interior = 0.0 if "no_interior" in flags else observations.interior_seen
 
-        def obs(task=None):
+        def obs(task=None, prior=prior, interior=interior):
             return Observations(parts=observations.parts, pose=observations.pose,
                                 containment=observations.containment, category_prior=prior,
                                 task=task, handles=observations.handles,

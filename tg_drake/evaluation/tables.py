@@ -352,7 +352,7 @@ def _failures(rs) -> dict:
 def ablations(cat: dict, tsk: dict, pre: dict) -> dict:
     top, excl, interior = {}, {}, {}
     for dataset in tsk:
-        def row(m):
+        def row(m, dataset=dataset):
             return {"category": cat[dataset].get(m), "task_E0": tsk[dataset][m]["E0"],
                     "pregrasp_E0": pre.get(dataset, {}).get(m, {}).get("E0")}
         top[dataset] = {"full_prior": row("plm"), "top_category": row("plm_top")}

@@ -35,6 +35,7 @@ from tg_drake.grasping.hypotheses import (
 from tg_drake.objects import LibraryObject, get_object, sample_surface
 
 KINDS = ("box", "perturbed", "random")
+DEFAULT_DGI = DgiConfig()  # the default features (frozen: one shared default is safe)
 
 
 @dataclass(frozen=True)
@@ -156,7 +157,7 @@ def training_order(records: list[dict]) -> list[dict]:
     return [r for _, rows in _by_scene(records) for r in rows]
 
 
-def training_set(records: list[dict], *, seed: int, config: DgiConfig = DgiConfig(),
+def training_set(records: list[dict], *, seed: int, config: DgiConfig = DEFAULT_DGI,
                  sampling: SamplingConfig = SamplingConfig()) -> TrainingSet:
     """Features and labels of the executed grasps with status "ok" (see collect_grasps.py), in
     the order of `training_order`."""

@@ -567,7 +567,8 @@ def learned_text(result: FitResult, *, header: Sequence[str], directory: Path | 
             end += 1
         values = iter(c.after)
         for j in range(start, min(end + 1, len(lines))):
-            lines[j] = _NUMBER.sub(lambda m: _fmt(next(values, float(m.group(1)))), lines[j])
+            lines[j] = _NUMBER.sub(lambda m, values=values: _fmt(next(values, float(m.group(1)))),
+                                  lines[j])
     head = [f"% {h}" if h else "%" for h in header]
     return "\n".join(head + ["%"] + lines) + "\n"
 
