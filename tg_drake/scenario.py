@@ -66,7 +66,8 @@ def default_cameras() -> dict[str, CameraConfig]:
 
 
 def look_at(p_WC, p_WTarget, up_W=(0.0, 0.0, 1.0)) -> RigidTransform:
-    """Pose of a Drake camera frame (x right, y down, z forward) at `p_WC` looking at `p_WTarget`."""
+    """Pose of a Drake camera frame (x right, y down, z forward) at `p_WC` looking at
+    `p_WTarget`."""
     p_WC, p_WTarget, up_W = map(np.asarray, (p_WC, p_WTarget, up_W))
     z = p_WTarget - p_WC
     z = z / np.linalg.norm(z)

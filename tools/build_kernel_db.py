@@ -200,8 +200,9 @@ def _same(a: KernelDatabase, b: KernelDatabase) -> bool:
                 b.entries_ground_truth, b.library_fingerprint, b.projections.w)
             and np.array_equal(a.projections.v, b.projections.v)
             and np.array_equal(a.projections.b, b.projections.b)
-            and all(np.array_equal(x, y) for x, y in zip(fa.vocabularies, fb.vocabularies))
-            and all((x != y).nnz == 0 for x, y in zip(fa.counts, fb.counts)))
+            and all(np.array_equal(x, y)
+                    for x, y in zip(fa.vocabularies, fb.vocabularies, strict=False))
+            and all((x != y).nnz == 0 for x, y in zip(fa.counts, fb.counts, strict=False)))
 
 
 if __name__ == "__main__":

@@ -144,7 +144,7 @@ def mass_free_labels(records: list[dict], light: list[dict], seed: int, mass: fl
         f[test] = SVC(kernel="rbf", gamma=own["gamma"], C=1.0).fit(
             X[train], data.y[train]).decision_function(X[test])
     same = defaultdict(list)
-    for r, y in zip(ordered, y_real):
+    for r, y in zip(ordered, y_real, strict=False):
         same[get_object(r["object"]).category].append(int(r["success"]) == y)
     ok = [r for r in light if r.get("status") == "ok"]
     return {"mass_kg": mass, "n_grasps": len(ok), "n_positive": sum(bool(r["success"]) for r in ok),

@@ -119,7 +119,7 @@ def test_wsg_pads_and_body(station_robot, opening):
     wsg = plant.GetModelInstanceByName("wsg")
     plant.SetPositions(context, wsg, [-opening / 2, opening / 2])
     expected = robot.wsg_pad_boxes(opening)
-    for name, (centre, size) in zip(robot.WSG_FINGERS, expected):
+    for name, (centre, size) in zip(robot.WSG_FINGERS, expected, strict=False):
         ((c, s),) = _boxes_in_G(plant, scene_graph, context, name)
         np.testing.assert_allclose(c, centre, atol=1e-12)
         np.testing.assert_allclose(s, size, atol=1e-12)

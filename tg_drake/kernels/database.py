@@ -281,7 +281,8 @@ class KernelDatabase:
             matrices = [
                 sp.csc_matrix((cnt, gid, np.concatenate([[0], np.cumsum(nnz)])),
                               shape=(n_graphs, len(voc)))
-                for voc, nnz, gid, cnt in zip(vocabularies, column_nnz, graph_ids, counts)]
+                for voc, nnz, gid, cnt in zip(vocabularies, column_nnz, graph_ids, counts,
+                                              strict=False)]
             return cls(
                 object_ids=data["object_ids"].astype(str),
                 categories=data["categories"].astype(np.int64),

@@ -243,7 +243,7 @@ class GroundTruthPerception(_LatchedPerception):
         self._scene = SceneDescription(objects=[
             describe_library_object(i, _matrix(X), X_WT, spacing=spacing, rng=rng, pose=p,
                                     containment=c)
-            for i, X, p, c in zip(object_ids, X_WO, poses, containments)], X_WT=X_WT)
+            for i, X, p, c in zip(object_ids, X_WO, poses, containments, strict=False)], X_WT=X_WT)
         self._declare_latch()
 
     def _perceive(self, context) -> SceneDescription:
