@@ -158,7 +158,7 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser
         name=p.instance_name, file=get_object(p.id).sdf_url)) for p in scenario.objects]
     added = ProcessModelDirectives(ModelDirectives(directives=directives), parser)
     objects = {}
-    for placement, info in zip(scenario.objects, added, strict=False):
+    for placement, info in zip(scenario.objects, added, strict=True):
         instance = info.model_instance
         objects[placement.instance_name] = instance
         body = plant.get_body(plant.GetBodyIndices(instance)[0])

@@ -135,7 +135,7 @@ class CategoryDistribution:
     # (database object id, its category, normalised kernel value), most similar first.
 
     def as_dict(self) -> dict[str, float]:
-        return {c: float(p) for c, p in zip(CATEGORIES, self.probabilities, strict=False) if p > 0}
+        return {c: float(p) for c, p in zip(CATEGORIES, self.probabilities, strict=True) if p > 0}
 
 
 @dataclass

@@ -160,7 +160,7 @@ def test_every_distribution_sums_to_one_on_random_scenes(specific, general):
         parts = {p: float(rng.choice([1.0, rng.uniform(0.5, 1.0)])) if p in signature
                  else float(rng.choice([0.0, rng.uniform(0.0, 0.3)])) for p in PART_LABELS}
         pose = dict(zip(POSES, rng.dirichlet(np.ones(3)), strict=False))
-        prior = dict(zip(CATEGORIES, rng.dirichlet(np.full(len(CATEGORIES), 0.5)), strict=False))
+        prior = dict(zip(CATEGORIES, rng.dirichlet(np.full(len(CATEGORIES), 0.5)), strict=True))
         task = None if rng.uniform() < 0.5 else str(rng.choice(TASKS))
         obs = Observations(parts=parts, pose=pose, category_prior=prior, task=task,
                            containment={"empty": float(rng.uniform())})

@@ -73,7 +73,7 @@ def _prior(kind: str, priors: dict) -> dict | None:
     if kind == "top":
         p = np.eye(len(CATEGORIES))[int(np.argmax(p))]
     p = (1.0 - PRIOR_FLOOR) * p + PRIOR_FLOOR / len(CATEGORIES)
-    return dict(zip(CATEGORIES, p.tolist(), strict=False))
+    return dict(zip(CATEGORIES, p.tolist(), strict=True))
 
 
 def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS,

@@ -105,7 +105,7 @@ def scene_grasps(obj: LibraryObject, pose: str, *, seed: int,
     p_O, n_O, labels = sample_surface(obj, spacing=0.003, rng=rng)
     boxes = [X_WO @ X_OB for X_OB, _ in part_boxes(p_O, labels).values()]
     halves = [h for _, h in part_boxes(p_O, labels).values()]
-    box = np.concatenate([box_grasps(X, h) for X, h in zip(boxes, halves, strict=False)])
+    box = np.concatenate([box_grasps(X, h) for X, h in zip(boxes, halves, strict=True)])
     perturbed = perturb_grasps(np.repeat(box, config.perturbed_per_box, axis=0), rng,
                                position_std=config.position_std, angle_std=config.angle_std)
     p_W = p_O @ X_WO[:3, :3].T + X_WO[:3, 3]

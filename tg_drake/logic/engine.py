@@ -111,7 +111,7 @@ class LogicAnswer:
             return {p: float(values[i]) for i, p in enumerate(names) if p in self.observed_parts}
         if query == "task" and self.given_task is not None:
             return {self.given_task: 1.0}
-        return {n: float(v) for n, v in zip(names, values, strict=False)}
+        return {n: float(v) for n, v in zip(names, values, strict=True)}
 
     def to_semantics(self, target: int = 0) -> GraspSemantics:
         return GraspSemantics(

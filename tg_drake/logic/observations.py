@@ -223,7 +223,7 @@ class Observations:
                 raise RuleError(f"prior_floor must lie in [0, 1], got {prior_floor}",
                                 field="prior_floor")
             p = (1.0 - prior_floor) * p + prior_floor / len(CATEGORIES)
-            category_prior = dict(zip(CATEGORIES, p.tolist(), strict=False))
+            category_prior = dict(zip(CATEGORIES, p.tolist(), strict=True))
         return cls(parts=dict(obj.part_probabilities), pose=dict(obj.pose_likelihood),
                    containment=None if obj.containment is None else {obj.containment: 1.0},
                    category_prior=category_prior, task=task or None,
