@@ -1,6 +1,7 @@
 """`tg-drake bench`: speed figures, each a ratio against a reference measured in the same run.
 
-Each figure is a function returning a `Figure`; stages register theirs in FIGURES (name → "module:function").
+Each figure is a function returning a `Figure`; stages register theirs in FIGURES
+(name → "module:function").
 Output: one JSON object, figure name → {median, unit, reference, reference_median, speedup}.
 """
 
@@ -10,9 +11,9 @@ import importlib
 import json
 import statistics
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Callable
 
 HELP = "measure the speed figures (JSON of medians and ratios against references)"
 
@@ -36,7 +37,8 @@ class Figure:
     unit: str
     reference: str | None = None  # what the reference is
     reference_median: float | None = None
-    speedup: float | None = None  # > 1: we are faster (reference/median for times, median/reference for rates)
+    # > 1: we are faster (reference/median for times, median/reference for rates)
+    speedup: float | None = None
 
 
 def median_time(fn: Callable[[], object], *, repeats: int = 5, warmup: int = 1) -> float:

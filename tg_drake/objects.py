@@ -8,8 +8,8 @@ mass properties from the mesh volume and material densities, rigid-hydroelastic 
 
 Object frame O:
 
-- containers (pan, pot, cup, glass, bowl, bottle, can): origin at the centre of the bottom, z along the
-  symmetry axis towards the opening (or neck), handles towards +x;
+- containers (pan, pot, cup, glass, bowl, bottle, can): origin at the centre of the bottom, z along
+  the symmetry axis towards the opening (or neck), handles towards +x;
 - tools (hammer, knife, screwdriver, cooking_tool): x along the long axis from the handle towards
   the usable area, z normal to the face the tool lies on (up when lying flat), origin at the centre
   of the bottom face of the bounding box.
@@ -83,7 +83,8 @@ class LibraryObject:
     mass: float  # [kg]
     volume: float  # [m³] volume of material (a closed bottle's or can's cavity excluded).
     cavity_volume: float | None  # [m³] containers: water volume when "full"; None otherwise.
-    cavity_centroid: tuple[float, float, float] | None  # [m] in O: centroid of that water (upright).
+    # [m] in O: centroid of that water (upright).
+    cavity_centroid: tuple[float, float, float] | None
     com: tuple[float, float, float]  # [m] centre of mass in O.
     inertia: np.ndarray  # (3, 3) [kg·m²] about the centre of mass, O's axes.
     extents: tuple[float, float, float]  # [m] bounding-box side lengths along O's x, y, z.
@@ -215,7 +216,8 @@ def _mesh(obj_id: str):
         raise ModelError(f"cannot read {obj_id}'s mesh: {e}", file=str(o.directory)) from None
     lines = text.splitlines()
     V = np.array([ln.split()[1:4] for ln in lines if ln.startswith("v ")], float)
-    F = np.array([[t.split("/")[0] for t in ln.split()[1:4]] for ln in lines if ln.startswith("f ")],
+    F = np.array([[t.split("/")[0] for t in ln.split()[1:4]]
+                  for ln in lines if ln.startswith("f ")],
                  np.int64) - 1
     if len(labels) != len(V) or F.min() < 0 or F.max() >= len(V):
         raise ModelError(f"{obj_id}: {len(V)} vertices, {len(labels)} part labels, face indices "

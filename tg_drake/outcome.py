@@ -44,7 +44,7 @@ class HandGeometries:
     table: frozenset
 
     @classmethod
-    def from_plant(cls, plant, *, object_body, wsg_instance, table_instance) -> "HandGeometries":
+    def from_plant(cls, plant, *, object_body, wsg_instance, table_instance) -> HandGeometries:
         """Reads the ids from a finalized plant's model (no context needed)."""
         def of(body):
             return frozenset(plant.GetCollisionGeometriesForBody(body))

@@ -292,7 +292,8 @@ def summary(result: dict) -> str:
     lines.append(f"outcome    {status}: {o['detail']}")
     if o["unreachable_parts"]:
         lines.append(f"closed loop: unreachable parts {o['unreachable_parts']} became "
-                     f"collision evidence; {o['requeries']} re-quer{'y' if o['requeries'] == 1 else 'ies'}")
+                     f"collision evidence; {o['requeries']} "
+                     f"re-quer{'y' if o['requeries'] == 1 else 'ies'}")
     t = result["timings"]
     lines.append("timings    " + ", ".join(f"{k} {v:.2f}s" for k, v in t.items()
                                           if k != "simulated_time"))

@@ -9,18 +9,28 @@ scenario says. The plant is not finalised: the caller may add to it first.
 
 from __future__ import annotations
 
-
 from pydrake.common.schema import Transform
 from pydrake.math import RigidTransform, RollPitchYaw
-from pydrake.multibody.parsing import (AddModel, AddWeld, ModelDirective, ModelDirectives,
-                                       ModelInstanceInfo, ProcessModelDirectives)
+from pydrake.multibody.parsing import (
+    AddModel,
+    AddWeld,
+    ModelDirective,
+    ModelDirectives,
+    ModelInstanceInfo,
+    ProcessModelDirectives,
+)
 from pydrake.multibody.plant import MultibodyPlant
 
 from tg_drake.errors import ModelError, ScenarioError
 from tg_drake.models import make_parser
-from tg_drake.robot import (IIWA_HOME, IIWA_JOINT_NAMES, WSG_FINGER_JOINTS, WSG_OPEN_POSITIONS,
-                            X_7G_RPY, X_7G_XYZ)
-
+from tg_drake.robot import (
+    IIWA_HOME,
+    IIWA_JOINT_NAMES,
+    WSG_FINGER_JOINTS,
+    WSG_OPEN_POSITIONS,
+    X_7G_RPY,
+    X_7G_XYZ,
+)
 
 
 def default_directives() -> list[ModelDirective]:

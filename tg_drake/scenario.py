@@ -15,13 +15,11 @@ library id, a pose label, a position on the table (in T) and a yaw about the tab
 
 import dataclasses
 import math
-import typing
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import yaml
-from scipy.spatial import ConvexHull
 from pydrake.common.schema import Transform
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
@@ -29,6 +27,7 @@ from pydrake.multibody.parsing import ModelDirective
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.sensors import CameraConfig
+from scipy.spatial import ConvexHull
 
 from tg_drake.errors import RuleError, ScenarioError, unknown_name
 from tg_drake.kernels.database import SOURCES as KERNEL_SOURCES
@@ -42,7 +41,6 @@ from tg_drake.robot_plants import default_directives
 from tg_drake.schema_check import SchemaError, check_document, load_raw
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, table_size_problem
 from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
-
 
 # The WSG body frame G on the iiwa's link 7 (tg_drake.robot: the mount).
 X_7G = RigidTransform(RollPitchYaw(*X_7G_RPY), X_7G_XYZ)
@@ -68,7 +66,8 @@ def default_cameras() -> dict[str, CameraConfig]:
 
 
 def look_at(p_WC, p_WTarget, up_W=(0.0, 0.0, 1.0)) -> RigidTransform:
-    """Pose of a Drake camera frame (x right, y down, z forward) at `p_WC` looking at `p_WTarget`."""
+    """Pose of a Drake camera frame (x right, y down, z forward) at `p_WC` looking at
+    `p_WTarget`."""
     p_WC, p_WTarget, up_W = map(np.asarray, (p_WC, p_WTarget, up_W))
     z = p_WTarget - p_WC
     z = z / np.linalg.norm(z)
@@ -116,7 +115,7 @@ class InverseDynamicsDriver:
     kd: float = 20.0  # [1/s]
 
 
-DriverConfig = typing.Union[JointPdDriver, WsgPdDriver, InverseDynamicsDriver]
+DriverConfig = JointPdDriver | WsgPdDriver | InverseDynamicsDriver
 
 
 def default_drivers() -> dict[str, DriverConfig]:
@@ -181,7 +180,7 @@ class GroundTruthPerception:
     spacing: float = 0.004  # [m] the meshes' surfaces are sampled this far apart
 
 
-PerceptionVariant = typing.Union[DepthPerception, GroundTruthPerception]
+PerceptionVariant = DepthPerception | GroundTruthPerception
 
 
 @dataclass
@@ -208,7 +207,7 @@ class OnePart:
     model: str = ""  # as DgiScorer.model
 
 
-ScoringVariant = typing.Union[DgiScorer, LocalOnly, OnePart]
+ScoringVariant = DgiScorer | LocalOnly | OnePart
 
 # The core's name (tg_drake.grasping.scoring.SELECTIONS) of each scoring variant.
 SELECTION_OF_SCORING = {DgiScorer: "pipeline", LocalOnly: "local_only", OnePart: "one_part"}
@@ -475,7 +474,7 @@ def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
     if isinstance(perception, DepthPerception) and perception.camera not in scenario.cameras:
         raise unknown_name("camera", perception.camera, list(scenario.cameras),
                            error=ScenarioError, file=where, field="pipeline.perception.camera")
-    for name, driver in scenario.model_drivers.items():
+    for name in scenario.model_drivers:
         if name not in ("iiwa", "wsg"):
             raise unknown_name("model driver", name, ["iiwa", "wsg"], error=ScenarioError,
                                file=where, field="model_drivers")

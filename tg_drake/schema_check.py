@@ -12,6 +12,7 @@ for an unknown key, the allowed keys with the closest match.
 
 import dataclasses
 import difflib
+import types
 import typing
 from pathlib import Path
 
@@ -96,7 +97,7 @@ def _fields(schema) -> dict | None:
 
 
 def _union_members(schema) -> tuple | None:
-    if typing.get_origin(schema) in (typing.Union, getattr(__import__("types"), "UnionType")):
+    if typing.get_origin(schema) in (typing.Union, types.UnionType):
         return typing.get_args(schema)
     return None
 
@@ -148,13 +149,13 @@ def check_document(value, schema, path: str = "") -> None:
         return  # unions of scalars: left to the loader
     origin = typing.get_origin(schema)
     args = typing.get_args(schema)
-    if origin in (list, typing.List):
+    if origin is list:
         if not isinstance(value, list):
             raise SchemaError(f"expected a list, got {_quote(value)}", where)
         for i, item in enumerate(value):
             check_document(item, args[0], f"{path}[{i}]")
         return
-    if origin in (dict, typing.Dict):
+    if origin is dict:
         if not isinstance(value, dict):
             raise SchemaError(f"expected a mapping of names to values, got {_quote(value)}",
                               where)

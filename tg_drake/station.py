@@ -1,13 +1,14 @@
 """The simulated station: iiwa 14 + WSG 50, a table, library objects and RGB-D cameras.
 
-    station = add_station(builder, scenario=scenario)   # into your own DiagramBuilder
-    diagram = make_station(scenario)                    # or a standalone diagram with exported ports
+    station = add_station(builder, scenario=scenario)  # into your own DiagramBuilder
+    diagram = make_station(scenario)  # or a standalone diagram with exported ports
 
 Contact is hydroelastic (`MultibodyPlantConfig`, SAP). The arm and the fingers are driven by the
-plant's own PD controllers on their joint actuators (implicit in SAP, which allows a much larger time
-step than an explicit inverse-dynamics loop); the WSG's finger force is limited through the finger
-actuators' effort limits, which SAP respects. Gravity on the arm and gripper is compensated (as the
-KUKA controller does for the arm and its configured payload); gravity acts on everything else.
+plant's own PD controllers on their joint actuators (implicit in SAP, which allows a much larger
+time step than an explicit inverse-dynamics loop); the WSG's finger force is limited through the
+finger actuators' effort limits, which SAP respects. Gravity on the arm and gripper is
+compensated (as the KUKA controller does for the arm and its configured payload); gravity acts on
+everything else.
 
 Cameras are `RgbdSensor`s added by Drake's `ApplyCameraConfig` from the scenario's `cameras`
 (the key names the camera; `renderer_name` and `renderer_class` choose its render engine:
@@ -32,14 +33,29 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.geometry import MakeRenderEngineGl, RenderEngineGlParams, SceneGraph, kHasRenderEngineGl
+from pydrake.geometry import (
+    MakeRenderEngineGl,
+    RenderEngineGlParams,
+    SceneGraph,
+    kHasRenderEngineGl,
+)
 from pydrake.lcm import DrakeLcm
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
-from pydrake.multibody.parsing import (AddModel, ModelDirective, ModelDirectives, Parser,
-                                       ProcessModelDirectives)
+from pydrake.multibody.parsing import (
+    AddModel,
+    ModelDirective,
+    ModelDirectives,
+    Parser,
+    ProcessModelDirectives,
+)
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
-from pydrake.multibody.tree import (JointActuatorIndex, ModelInstanceIndex, PdControllerGains, SpatialInertia,
-                                    UnitInertia)
+from pydrake.multibody.tree import (
+    JointActuatorIndex,
+    ModelInstanceIndex,
+    PdControllerGains,
+    SpatialInertia,
+    UnitInertia,
+)
 from pydrake.systems.controllers import InverseDynamicsController
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import MatrixGain
@@ -50,8 +66,13 @@ from tg_drake.models import make_parser
 from tg_drake.objects import get_object
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
 from tg_drake.robot_plants import add_scenario_models
-from tg_drake.scenario import (InverseDynamicsDriver, JointPdDriver, ObjectPlacement, Scenario,
-                               WsgPdDriver)
+from tg_drake.scenario import (
+    InverseDynamicsDriver,
+    JointPdDriver,
+    ObjectPlacement,
+    Scenario,
+    WsgPdDriver,
+)
 from tg_drake.table import add_table
 
 WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container
@@ -59,7 +80,8 @@ NO_LCM = "memq://null"  # the LCM URL that publishes nothing: the station sends 
 
 
 def placement_pose(scenario: Scenario, placement: ObjectPlacement) -> RigidTransform:
-    """X_WO of a placed object: table frame · (xy, yaw on the table) · the library's resting X_TO."""
+    """X_WO of a placed object: table frame · (xy, yaw on the table) · the library's resting
+    X_TO."""
     obj = get_object(placement.id)
     X_TO = obj.resting_pose(placement.pose).X_TO
     X_T_yaw = RigidTransform(RollPitchYaw(0, 0, np.deg2rad(placement.yaw)),
@@ -136,7 +158,7 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser
         name=p.instance_name, file=get_object(p.id).sdf_url)) for p in scenario.objects]
     added = ProcessModelDirectives(ModelDirectives(directives=directives), parser)
     objects = {}
-    for placement, info in zip(scenario.objects, added):
+    for placement, info in zip(scenario.objects, added, strict=True):
         instance = info.model_instance
         objects[placement.instance_name] = instance
         body = plant.get_body(plant.GetBodyIndices(instance)[0])
@@ -148,7 +170,8 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser
 
 def contents_cylinder(obj) -> tuple[float, float, np.ndarray]:
     """(radius, height, p_OC): the water of a full container as a cylinder of the cavity's volume,
-    of the inner diameter, standing on the container's base (O: origin at the bottom centre, z up)."""
+    of the inner diameter, standing on the container's base (O: origin at the bottom centre,
+    z up)."""
     d = obj.dimensions
     radius = d["diameter"] / 2 - d.get("wall", 0.0)
     height = obj.cavity_volume / (np.pi * radius**2)

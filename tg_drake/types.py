@@ -135,7 +135,7 @@ class CategoryDistribution:
     # (database object id, its category, normalised kernel value), most similar first.
 
     def as_dict(self) -> dict[str, float]:
-        return {c: float(p) for c, p in zip(CATEGORIES, self.probabilities) if p > 0}
+        return {c: float(p) for c, p in zip(CATEGORIES, self.probabilities, strict=True) if p > 0}
 
 
 @dataclass
@@ -151,7 +151,8 @@ class Explanation:
 
     answer: str
     probability: float
-    reasons: list[tuple[str, float]]  # (rule or observation text, share of probability), largest first.
+    # (rule or observation text, share of probability), largest first.
+    reasons: list[tuple[str, float]]
 
 
 @dataclass

@@ -37,10 +37,16 @@ import numpy as np
 
 from tg_drake.errors import KernelError
 from tg_drake.kernels.database import ENTRIES, KernelDatabase, prepare_cloud
-from tg_drake.kernels.graph import K_NEIGHBOURS
 from tg_drake.kernels.evaluation import query_outcomes
+from tg_drake.kernels.graph import K_NEIGHBOURS
 from tg_drake.kernels.library import (
-    SPACING, VIEW_YAWS_DEG, VIEWPOINTS, library_clouds, library_fingerprint, perceived_views)
+    SPACING,
+    VIEW_YAWS_DEG,
+    VIEWPOINTS,
+    library_clouds,
+    library_fingerprint,
+    perceived_views,
+)
 from tg_drake.kernels.propagation import BIN_WIDTH, T_MAX, LshProjections
 from tg_drake.types import CATEGORIES
 
@@ -194,8 +200,9 @@ def _same(a: KernelDatabase, b: KernelDatabase) -> bool:
                 b.entries_ground_truth, b.library_fingerprint, b.projections.w)
             and np.array_equal(a.projections.v, b.projections.v)
             and np.array_equal(a.projections.b, b.projections.b)
-            and all(np.array_equal(x, y) for x, y in zip(fa.vocabularies, fb.vocabularies))
-            and all((x != y).nnz == 0 for x, y in zip(fa.counts, fb.counts)))
+            and all(np.array_equal(x, y)
+                    for x, y in zip(fa.vocabularies, fb.vocabularies, strict=False))
+            and all((x != y).nnz == 0 for x, y in zip(fa.counts, fb.counts, strict=False)))
 
 
 if __name__ == "__main__":

@@ -2,7 +2,8 @@
 
 For every library object in every resting pose that suits it, the grasps of
 `tg_drake.grasping.dataset.scene_grasps` (part-box pre-grasps, perturbed copies, random ones) are
-executed by a free-floating WSG 50 in hydroelastic contact (`tg_drake.simulation.episode`): approach,
+executed by a free-floating WSG 50 in hydroelastic contact (`tg_drake.simulation.episode`):
+approach,
 close, lift, shake; the label is whether the object stays between the fingers. Jobs (batches of
 grasps on one scene) go through the executor interface and their records stream to JSON Lines; a
 rerun skips finished batches. A summary (counts per object and label, throughput) is written next
@@ -40,7 +41,8 @@ def make_jobs(objects, *, seed: int, batch: int, sampling: SamplingConfig,
         scene = scene_grasps(obj, pose, seed=seed, config=sampling)
         through_table += scene.n_through_table
         grasps = [{"index": i, "kind": str(k), "part": int(p), "X_WG": X.ravel().tolist()}
-                  for i, (X, k, p) in enumerate(zip(scene.X_WG, scene.kinds, scene.parts))]
+                  for i, (X, k, p) in enumerate(zip(scene.X_WG, scene.kinds, scene.parts,
+                                                    strict=False))]
         for b in range(0, len(grasps), batch):
             jobs.append(Job(f"{obj.id}/{pose}/{b // batch}", {
                 "object": obj.id, "pose": pose, "object_sdf": str(obj.sdf_path),

@@ -75,7 +75,6 @@ def evaluate(variant: Variant, X, data) -> dict:
     from sklearn.pipeline import make_pipeline
     from sklearn.preprocessing import StandardScaler
     from sklearn.svm import SVC
-
     from train_dgi import top_grasp_accuracy  # tools/ is on sys.path when run as a script
 
     def model(gamma):
@@ -127,10 +126,10 @@ def mass_free_labels(records: list[dict], light: list[dict], seed: int, mass: fl
     model trained on them judged by the real-mass labels (grasps executed fine in both sets)."""
     from sklearn.model_selection import GroupKFold
     from sklearn.svm import SVC
+    from train_dgi import top_grasp_accuracy
 
     from tg_drake.grasping.dataset import training_order
     from tg_drake.objects import get_object
-    from train_dgi import top_grasp_accuracy
 
     shipped = VARIANTS[0]
     X, data = features(light, shipped, seed)
@@ -145,7 +144,7 @@ def mass_free_labels(records: list[dict], light: list[dict], seed: int, mass: fl
         f[test] = SVC(kernel="rbf", gamma=own["gamma"], C=1.0).fit(
             X[train], data.y[train]).decision_function(X[test])
     same = defaultdict(list)
-    for r, y in zip(ordered, y_real):
+    for r, y in zip(ordered, y_real, strict=False):
         same[get_object(r["object"]).category].append(int(r["success"]) == y)
     ok = [r for r in light if r.get("status") == "ok"]
     return {"mass_kg": mass, "n_grasps": len(ok), "n_positive": sum(bool(r["success"]) for r in ok),

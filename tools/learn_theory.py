@@ -11,7 +11,8 @@
 Data. Every library object, in every pose that suits it, empty, and full when upright (containers
 only), grasped in turn at each of its parts: the pipeline runs with ground-truth perception (the
 paper's S_SYN setting), the task p&pOn (every object affords it; the task does not change what
-the robot does once the part is fixed) and `pipeline.scoring: !OnePart {part: ...}`, so that only that
+the robot does once the part is fixed) and `pipeline.scoring: !OnePart {part: ...}`, so that only
+that
 part's pre-grasp hypotheses are tried, best P(grasp | shape) first. A position and yaw on the table
 are drawn per scene from the seed. Upside-down pans are left out: the theory's constraint rules
 every grasp of them out, so nothing would be executed. One object per category (drawn from the
@@ -61,7 +62,7 @@ def split_objects(seed: int) -> dict[str, str]:
 
     rng = np.random.default_rng(seed)
     split = {}
-    for category, objects in library_by_category().items():
+    for objects in library_by_category().values():
         held_out = int(rng.integers(len(objects)))
         for i, obj in enumerate(objects):
             split[obj.id] = "test" if i == held_out else "train"
@@ -367,7 +368,7 @@ def grasp_success(compare: list[dict]) -> dict:
                      "rows": [{"scene": r["scene"], "task": r["task"],
                                "part": r.get("grasped_part"), "status": r["outcome"]["status"],
                                "reason": r["outcome"]["reason"], "served": k}
-                              for r, k in zip(rows, ok)]}
+                              for r, k in zip(rows, ok, strict=False)]}
     return out
 
 
@@ -438,7 +439,7 @@ def write_results(records: list[dict], e0: dict, success: dict, command: str) ->
     lines += ["", "Pipeline runs (held-out scene, task drawn with the seed):", "",
               "| scene | task | hand-written: part, outcome | learned: part, outcome |",
               "|---|---|---|---|"]
-    for a, b in zip(success["handwritten"]["rows"], success["learned"]["rows"]):
+    for a, b in zip(success["handwritten"]["rows"], success["learned"]["rows"], strict=False):
         lines.append(f"| {a['scene']} | {a['task']} | {a['part'] or '–'}, {a['status']}"
                      f"{' ✓' if a['served'] else ''} | {b['part'] or '–'}, {b['status']}"
                      f"{' ✓' if b['served'] else ''} |")

@@ -1,7 +1,8 @@
 """Generates the object library in models/objects/ from parametric shape families.
 
     python tools/make_objects.py            # (re)write models/objects/
-    python tools/make_objects.py --check    # regenerate into a temp dir, compare bytes, exit 1 on a difference
+    python tools/make_objects.py --check    # regenerate into a temp dir, compare bytes,
+                                            # exit 1 on a difference
     python tools/make_objects.py --out DIR  # write elsewhere
 
 Every object of the 11 categories is built from a few closed-surface primitives, with NumPy only
@@ -19,7 +20,8 @@ Every object of the 11 categories is built from a few closed-surface primitives,
 Each mesh is checked to be a closed, consistently oriented two-manifold with positive volume. Mass
 properties are exact volume integrals of the closed mesh (signed tetrahedra), per material: a
 sub-solid of another material (a wooden handle, an air-filled cavity) is integrated separately and
-its share moved from the body's density to its own. The resting transforms come from the convex hull:
+its share moved from the body's density to its own. The resting transforms come from the convex
+hull:
 for each pose, the object is put down on the hull face whose outward normal is closest to the pose's
 "down" direction; from there it tips over any edge of its support polygon its centre of mass
 projects beyond, and rolls over an edge it is within ROLL_MARGIN of when that lowers the centre of
@@ -28,12 +30,14 @@ mass (a mug on its side rolls until its handle touches, as it does in Drake).
 Meshes are written with per-corner shading normals (Drake's renderer requires them; smooth across
 edges under 40°, sharp at rims and bottoms) and 1 µm vertex resolution.
 
-Object frame O: containers — origin at the centre of the bottom, z along the symmetry axis towards the
-opening (or neck), handles towards +x. Tools — x along the long axis from the handle to the usable area,
+Object frame O: containers — origin at the centre of the bottom, z along the symmetry axis towards
+the opening (or neck), handles towards +x. Tools — x along the long axis from the handle to the
+usable area,
 z the normal of the hull face the tool lies on (up), origin at the centre of the bottom face of the
 axis-aligned bounding box, so the lying pose is the identity.
 
-Shapes are drawn by Latin hypercube sampling within realistic ranges (fixed seed): each instance of a
+Shapes are drawn by Latin hypercube sampling within realistic ranges (fixed seed): each instance of
+a
 category falls in a different quarter of every range, so instances differ in size and proportions.
 """
 
@@ -299,7 +303,7 @@ def resample(poly: np.ndarray, key: np.ndarray, h: float, h_from=None) -> np.nda
     h_from[i] (if finite) overrides h for the piece that starts at key point i."""
     ks = np.flatnonzero(key)
     out = []
-    for k0, k1 in zip(ks[:-1], ks[1:]):
+    for k0, k1 in zip(ks[:-1], ks[1:], strict=False):
         sub = poly[k0:k1 + 1]
         s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(sub, axis=0), axis=1))])
         hk = h if h_from is None or not np.isfinite(h_from[k0]) else h_from[k0]
@@ -338,7 +342,8 @@ class Profile:
         self.add(np.array([p0, p1], float), h=h)
 
     def curve(self, f, u0, u1, z_keys=(), n=600):
-        """Adds f(u) for u in [u0, u1]; points with z in z_keys (found on the dense curve) are keys."""
+        """Adds f(u) for u in [u0, u1]; points with z in z_keys (found on the dense curve) are
+        keys."""
         u = np.linspace(u0, u1, n)
         P = f(u)
         extra = []
@@ -383,13 +388,15 @@ class Profile:
                         np.concatenate(self.h))
 
 
-def revolve(profile: np.ndarray, n: int, *, p=2.0, R=np.eye(3), origin=np.zeros(3)):
+def revolve(profile: np.ndarray, n: int, *, p=2.0, R=None, origin=None):
     """Rings of a profile (r, z) from the axis to the axis, revolved about local z.
 
     Ring vertices sit at angles (j + ½)·2π/n, so faces are centred on multiples of 2π/n (a face
     points exactly along ±x and ±y when n is a multiple of 4). Returns (rings, start pole, end pole)
-    in the frame (R, origin).
+    in the frame (R, origin), by default the identity.
     """
+    R = np.eye(3) if R is None else R
+    origin = np.zeros(3) if origin is None else origin
     sec = superellipse(n, 1.0, 1.0, p, phase=np.pi / n)
     inner = profile[1:-1]
     loc = np.concatenate([inner[:, :1, None] * sec[None, :, :],
@@ -407,7 +414,8 @@ def select_quads(mb, qf, V, predicate):
     """Quads of a loft (by face-pair indices qf (K-1, n, 2)) whose centroid satisfies predicate."""
     F = mb.face_array()
     cen = V[F[qf[..., 0]]].mean(axis=2) * 0.5 + V[F[qf[..., 1]]].mean(axis=2) * 0.5
-    nrm = np.cross(V[F[qf[..., 0], 1]] - V[F[qf[..., 0], 0]], V[F[qf[..., 0], 2]] - V[F[qf[..., 0], 0]])
+    nrm = np.cross(V[F[qf[..., 0], 1]] - V[F[qf[..., 0], 0]],
+                   V[F[qf[..., 0], 2]] - V[F[qf[..., 0], 0]])
     nrm /= np.linalg.norm(nrm, axis=-1, keepdims=True) + 1e-30
     mask = predicate(cen, nrm)
     if not mask.any():
@@ -432,7 +440,8 @@ def tube(mb, curve, e_a, half_a, half_b, label, *, n_sec=16, h=0.008, p=2.0, sta
     C, T = f(s)
     sec = superellipse(n_sec, 1.0, 1.0, p)
     scale = np.ones(m) if taper is None else taper(s / L)
-    rings = [C[i] + scale[i] * (half_a * sec[:, :1] * e_a + half_b * sec[:, 1:] * np.cross(T[i], e_a))
+    rings = [C[i] + scale[i] * (half_a * sec[:, :1] * e_a
+                                + half_b * sec[:, 1:] * np.cross(T[i], e_a))
              for i in range(m)]
     if cap:
         r_cap = min(half_a, half_b) * scale[-1]
@@ -440,7 +449,8 @@ def tube(mb, curve, e_a, half_a, half_b, label, *, n_sec=16, h=0.008, p=2.0, sta
         for ps in psi:
             c = C[-1] + T[-1] * r_cap * np.sin(ps)
             k = math.cos(ps) * scale[-1]
-            rings.append(c + k * (half_a * sec[:, :1] * e_a + half_b * sec[:, 1:] * np.cross(T[-1], e_a)))
+            rings.append(c + k * (half_a * sec[:, :1] * e_a
+                                  + half_b * sec[:, 1:] * np.cross(T[-1], e_a)))
     rings = np.array(rings)
     end = C[-1] + T[-1] * min(half_a, half_b) * scale[-1] if cap else None
     idx, _ = loft(mb, rings, label, end=end, end_label=label)
@@ -527,7 +537,8 @@ def mass_properties(V, F, density, pieces=()) -> MassProperties:
 
 
 def rot_to(n, target):
-    """The smallest rotation taking unit vector n to target (a half turn about x or y if opposite)."""
+    """The smallest rotation taking unit vector n to target (a half turn about x or y if
+    opposite)."""
     n, target = np.asarray(n, float), np.asarray(target, float)
     axis = np.cross(n, target)
     s, c = np.linalg.norm(axis), float(n @ target)
@@ -752,7 +763,7 @@ def offset_closed_profile(prof, t):
     return q
 
 
-def body_of_revolution(mb, prof, n, *, label_fn, R=np.eye(3), origin=np.zeros(3), p=2.0):
+def body_of_revolution(mb, prof, n, *, label_fn, R=None, origin=None, p=2.0):
     rings, s, e = revolve(prof, n, p=p, R=R, origin=origin)
     labels = label_fn(prof)
     idx, qf = loft(mb, rings, labels[1:-1], start=s, end=e, start_label=labels[0],
@@ -792,7 +803,6 @@ def make_open_container(category, P, variant):
     h = {"pan": 0.016, "pot": 0.015, "cup": 0.009, "glass": 0.011, "bowl": 0.011}[category]
     mb = MeshBuilder()
     z_keys = []
-    handle_specs = []
     if category == "cup":
         z1, z2 = P["z1"] * H, P["z2"] * H
         hp = P["hb"] + 0.0035  # patch half height: handle half thickness + a flange
@@ -847,7 +857,7 @@ def make_open_container(category, P, variant):
                      for phi, _, _ in ends]
             (_, p1, n1), (_, p2, n2) = ends
             k = P["reach"] * 1.3
-            curve = lambda t, p1=p1, n1=n1, p2=p2, n2=n2: bezier(  # noqa: E731
+            curve = lambda t, p1=p1, n1=n1, p2=p2, n2=n2, k=k: bezier(  # noqa: E731
                 p1, p1 + k * n1, p2 + k * n2, p2, t)
             tidx, rings, _ = tube(mb, curve, e_z, P["hr"], P["hr"], HANDLE,
                                   start_loop=loops[0], end_loop=loops[1], h=0.008, n_sec=12)
@@ -856,7 +866,8 @@ def make_open_container(category, P, variant):
     V, F, L = mb.result()
     mats = variant["materials"]
     handle_mat = mats.get("handle", variant["material"])
-    solids = [(Vp, Fp, handle_mat) for Vp, Fp in pieces] if handle_mat != variant["material"] else []
+    solids = ([(Vp, Fp, handle_mat) for Vp, Fp in pieces]
+              if handle_mat != variant["material"] else [])
     return Model(category, V, F, L, variant["material"],
                  {"handle": handle_mat} if solids else {}, solids, cavity, dims,
                  rim={"wall": wall, "opening_radius": r_top - wall})
@@ -953,7 +964,7 @@ def make_knife(P, variant):
     xs, k = rounded_end(0.012, 0.0, 4)
     st.append((0.0, 0, 0, 0, 0, 2, 0, 0))
     lab.append(HANDLE)
-    for x, kk in zip(xs[::-1], k[::-1]):
+    for x, kk in zip(xs[::-1], k[::-1], strict=False):
         st.append((x, 0, 0, ha * kk, hb * kk, 2.0, 0, 0, 0.4 * hb * kk))
         lab.append(HANDLE)
     for x in np.linspace(0.012, Lh, 6):  # flat-sided scales (a rounded-rectangle section)
@@ -996,7 +1007,7 @@ def make_screwdriver(P, variant):
     Lh, Ls, rh, rs = P["Lh"], P["Ls"], P["rh"], P["rs"]
     st, lab = [(0.0, 0, 0, 0, 0, 2, 0, 0)], [HANDLE]
     xs, k = rounded_end(0.010, 0.0, 4)
-    for x, kk in zip(xs[::-1], k[::-1]):
+    for x, kk in zip(xs[::-1], k[::-1], strict=False):
         st.append((x, 0, 0, 0.92 * rh * kk, 0.92 * rh * kk, 2, 6, 0.06))
         lab.append(HANDLE)
     prof = lambda t: rh * (0.92 + 0.08 * np.sin(np.pi * np.clip(t, 0, 1)) ** 0.5)  # noqa: E731
@@ -1015,14 +1026,16 @@ def make_screwdriver(P, variant):
         lab.append(USABLE)
     if variant["tip"] == "flat":
         for t in (0.4, 0.8):
-            st.append((x_tip - 0.010 * (1 - t), 0, 0, rs * (1 + 0.15 * t), rs * (1 - 0.8 * t), 2.5, 0, 0))
+            st.append((x_tip - 0.010 * (1 - t), 0, 0, rs * (1 + 0.15 * t), rs * (1 - 0.8 * t),
+                       2.5, 0, 0))
             lab.append(USABLE)
         st.append((x_tip, 0, 0, rs * 1.15, rs * 0.2, 4, 0, 0))
         lab.append(USABLE)
         st.append((x_tip + 0.0003, 0, 0, 0, 0, 2, 0, 0))
     else:  # cross-head: a cone to a point
         for t in (0.35, 0.7):
-            st.append((x_tip - 0.010 * (1 - t), 0, 0, rs * (1 - 0.8 * t), rs * (1 - 0.8 * t), 2, 0, 0))
+            st.append((x_tip - 0.010 * (1 - t), 0, 0, rs * (1 - 0.8 * t), rs * (1 - 0.8 * t),
+                       2, 0, 0))
             lab.append(USABLE)
         st.append((x_tip, 0, 0, 0, 0, 2, 0, 0))
     lab.append(USABLE)
@@ -1041,25 +1054,25 @@ def make_spatula(P, variant):
     ha, hb = P["ha"], P["hb"]
     st, lab = [(0.0, 0, 0, 0, 0, 2, 0, 0)], [HANDLE]
     xs, k = rounded_end(0.008, 0.0, 4)
-    for x, kk in zip(xs[::-1], k[::-1]):
+    for x, kk in zip(xs[::-1], k[::-1], strict=False):
         st.append((x, 0, 0, ha * kk, hb * kk, 2.0, 0, 0, 0.7 * hb * kk))
         lab.append(HANDLE)
     for x in np.linspace(0.008, Lh, 5):  # a flat handle, as moulded or riveted ones are
         st.append((x, 0, 0, ha, hb, 2.0, 0, 0, 0.7 * hb))
         lab.append(HANDLE)
     for x, a, b in zip(np.linspace(Lh, Lh + Ln, 4)[1:], (0.8 * ha, 0.55 * ha, 0.45 * ha),
-                       (0.7 * hb, 0.5 * hb, 0.4 * hb)):
+                       (0.7 * hb, 0.5 * hb, 0.4 * hb), strict=False):
         st.append((x, 0, 0, a, max(b, t / 2), 2.0, 0, 0, 0.7 * max(b, t / 2)))
         lab.append(HANDLE)
     x0 = Lh + Ln
-    for s_, w in zip((0.01, 0.02, 0.03), (0.5, 0.8, 1.0)):  # the head widens
+    for s_, w in zip((0.01, 0.02, 0.03), (0.5, 0.8, 1.0), strict=False):  # the head widens
         st.append((x0 + s_, 0, 0, max(w * W / 2, 0.45 * ha), t / 2, 6, 0, 0))
         lab.append(USABLE)
     for x in np.linspace(x0 + 0.03, x0 + Lhd - 0.008, 4)[1:]:
         st.append((x, 0, 0, W / 2, t / 2, 6, 0, 0))
         lab.append(USABLE)
     xe, ke = rounded_end(x0 + Lhd - 0.008, x0 + Lhd, 3)
-    for x, kk in zip(xe, ke):  # rounded corners at the working edge
+    for x, kk in zip(xe, ke, strict=False):  # rounded corners at the working edge
         st.append((x, 0, 0, W / 2 * (0.6 + 0.4 * kk), t / 2 * (0.5 + 0.5 * kk), 6, 0, 0))
         lab.append(USABLE)
     st.append((x0 + Lhd, 0, 0, 0, 0, 2, 0, 0))
@@ -1334,7 +1347,7 @@ def finish(obj_id: str, m: Model) -> dict:
 
 
 def sdf_text(obj_id, entry, mp) -> str:
-    I = mp.inertia
+    inertia = mp.inertia
     r, g, b = entry["color"]
     return f"""<?xml version="1.0"?>
 <!-- Generated by tools/make_objects.py: do not edit. {entry['category']}, {entry['material']},
@@ -1346,12 +1359,12 @@ def sdf_text(obj_id, entry, mp) -> str:
         <pose>{mp.com[0]:.6f} {mp.com[1]:.6f} {mp.com[2]:.6f} 0 0 0</pose>
         <mass>{mp.mass:.9g}</mass>
         <inertia>
-          <ixx>{I[0, 0]:.9e}</ixx>
-          <ixy>{I[0, 1]:.9e}</ixy>
-          <ixz>{I[0, 2]:.9e}</ixz>
-          <iyy>{I[1, 1]:.9e}</iyy>
-          <iyz>{I[1, 2]:.9e}</iyz>
-          <izz>{I[2, 2]:.9e}</izz>
+          <ixx>{inertia[0, 0]:.9e}</ixx>
+          <ixy>{inertia[0, 1]:.9e}</ixy>
+          <ixz>{inertia[0, 2]:.9e}</ixz>
+          <iyy>{inertia[1, 1]:.9e}</iyy>
+          <iyz>{inertia[1, 2]:.9e}</iyz>
+          <izz>{inertia[2, 2]:.9e}</izz>
         </inertia>
       </inertial>
       <visual name="visual">
@@ -1413,7 +1426,7 @@ def obj_text(obj_id, V, F) -> str:
     v = "\n".join(f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in V.tolist())
     vn = "\n".join(f"vn {x:.4f} {y:.4f} {z:.4f}" for x, y, z in N.tolist())
     f = "\n".join(f"f {a}//{na} {b}//{nb} {c}//{nc}" for (a, b, c), (na, nb, nc)
-                   in zip((F + 1).tolist(), (NI + 1).tolist()))
+                   in zip((F + 1).tolist(), (NI + 1).tolist(), strict=False))
     return head + f"o {obj_id}\n" + v + "\n" + vn + "\n" + f + "\n"
 
 
@@ -1439,13 +1452,20 @@ def generate(out: Path, verbose=False) -> dict:
                 print(f"{obj_id:16s} {entry['mass']:7.3f} kg  {len(F):5d} triangles  "
                       f"poses {', '.join(entry['poses'])}")
     header = ("# The object library, generated by tools/make_objects.py: do not edit.\n"
-              "# Units: metres, kilograms, kg/m³, kg·m². Object frame O: containers — origin at the\n"
-              "# bottom centre, z along the symmetry axis towards the opening, handles towards +x;\n"
-              "# tools — x along the long axis towards the usable area, z up when lying flat, origin at\n"
-              "# the bottom centre of the bounding box. cavity_volume, cavity_centroid: the water of a\n"
-              "# 'full' container (filled to the rim, upright). poses: X_TO (table-top frame T → object frame\n"
-              "# O) as xyz + rpy (Drake's RollPitchYaw) resting on z = 0; support_margin: how far the\n"
-              "# centre of mass projects inside the support polygon. inertia: ixx ixy ixz iyy iyz izz\n"
+              "# Units: metres, kilograms, kg/m³, kg·m². Object "
+              "frame O: containers — origin at the\n"
+              "# bottom centre, z along the symmetry axis towards "
+              "the opening, handles towards +x;\n"
+              "# tools — x along the long axis towards the usable "
+              "area, z up when lying flat, origin at\n"
+              "# the bottom centre of the bounding box. "
+              "cavity_volume, cavity_centroid: the water of a\n"
+              "# 'full' container (filled to the rim, upright). poses: "
+              "X_TO (table-top frame T → object frame\n"
+              "# O) as xyz + rpy (Drake's RollPitchYaw) resting on z "
+              "= 0; support_margin: how far the\n"
+              "# centre of mass projects inside the support polygon. "
+              "inertia: ixx ixy ixz iyy iyz izz\n"
               "# about the centre of mass. grasp_widths: smallest width of each part across the\n"
               "# object's xy plane (an open container's top: its rim wall).\n")
     text = header + yaml.safe_dump({"objects": library}, sort_keys=False,

@@ -1,6 +1,7 @@
 """Writes the robot and table model files in models/ from the published figures.
 
-    python -m tools.make_robot_models          # (re)write models/iiwa14, models/wsg_50, models/table
+    python -m tools.make_robot_models          # (re)write models/iiwa14, models/wsg_50,
+                                               # models/table
     python -m tools.make_robot_models --check  # fail if the committed files differ from the output
 
 The robots' figures (kinematics, limits; WSG 50 dimensions, stroke, force) are those of
@@ -18,17 +19,30 @@ import sys
 import tempfile
 from pathlib import Path
 
-from tg_drake.robot import (IIWA_FLANGE_Z, IIWA_JOINTS, WSG_BODY, WSG_BODY_CENTRE_G, WSG_BODY_MASS,
-                            WSG_BODY_SIZE, WSG_FINGER_JOINTS, WSG_FINGER_MASS, WSG_FINGER_VELOCITY,
-                            WSG_FINGERS, WSG_FORCE_LIMIT, WSG_PAD_CENTRE_Y, WSG_PAD_SIZE,
-                            WSG_STROKE)
+from tg_drake.robot import (
+    IIWA_FLANGE_Z,
+    IIWA_JOINTS,
+    WSG_BODY,
+    WSG_BODY_CENTRE_G,
+    WSG_BODY_MASS,
+    WSG_BODY_SIZE,
+    WSG_FINGER_JOINTS,
+    WSG_FINGER_MASS,
+    WSG_FINGER_VELOCITY,
+    WSG_FINGERS,
+    WSG_FORCE_LIMIT,
+    WSG_PAD_CENTRE_Y,
+    WSG_PAD_SIZE,
+    WSG_STROKE,
+)
 from tg_drake.table import table_sdf
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 
 PI = math.pi
 
-# link: (mass [kg], com xyz, (Ixx, Iyy, Izz), collision (radius, length, centre xyz, rpy) or sphere).
+# link: (mass [kg], com xyz, (Ixx, Iyy, Izz), collision (radius, length, centre xyz, rpy) or
+# sphere).
 IIWA_LINKS = {
     "iiwa_link_0": (5.00, (-0.1, 0, 0.07), (0.05, 0.06, 0.03),
                     ("cylinder", 0.139, 0.17, (-0.015, 0, 0.07), (0, 0, 0))),
@@ -109,7 +123,8 @@ def iiwa_urdf() -> str:
                    '    <type>transmission_interface/SimpleTransmission</type>\n'
                    f'    <joint name="{name}"><hardwareInterface>PositionJointInterface'
                    '</hardwareInterface></joint>\n'
-                   f'    <actuator name="{name}_actuator"><mechanicalReduction>1</mechanicalReduction>'
+                   f'    <actuator name="{name}_actuator">'
+                   '<mechanicalReduction>1</mechanicalReduction>'
                    '</actuator>\n  </transmission>')
     out.append('  <joint name="iiwa_joint_ee" type="fixed">\n'
                '    <parent link="iiwa_link_7"/>\n    <child link="iiwa_link_ee"/>\n'
@@ -142,8 +157,10 @@ def _sdf_inertial(mass, size, pose="0 0 0 0 0 0") -> str:
 def _compliant(h) -> str:
     return ("          <drake:proximity_properties>\n"
             "            <drake:compliant_hydroelastic/>\n"
-            f"            <drake:hydroelastic_modulus>{h['modulus']:.6g}</drake:hydroelastic_modulus>\n"
-            f"            <drake:mesh_resolution_hint>{h['resolution']}</drake:mesh_resolution_hint>\n"
+            f"            <drake:hydroelastic_modulus>{h['modulus']:.6g}"
+            "</drake:hydroelastic_modulus>\n"
+            f"            <drake:mesh_resolution_hint>{h['resolution']}"
+            "</drake:mesh_resolution_hint>\n"
             f"            <drake:hunt_crossley_dissipation>{h['dissipation']}"
             "</drake:hunt_crossley_dissipation>\n"
             f"            <drake:mu_dynamic>{h['mu']}</drake:mu_dynamic>\n"
@@ -156,9 +173,10 @@ def wsg_sdf() -> str:
     px, py, pz = WSG_PAD_SIZE
     fingers = []
     for finger, joint, sign, lower, upper in zip(WSG_FINGERS, WSG_FINGER_JOINTS, (-1, 1),
-                                                 (-WSG_STROKE, 0.0), (0.0, WSG_STROKE)):
-        # The finger frame moves with its joint; the pad's inner face sits at x = q (the joint value),
-        # so the opening is q_right − q_left.
+                                                 (-WSG_STROKE, 0.0), (0.0, WSG_STROKE),
+                                                 strict=False):
+        # The finger frame moves with its joint; the pad's inner face sits at x = q (the joint
+        # value), so the opening is q_right − q_left.
         pad_pose = f"{sign * px / 2:.6g} {WSG_PAD_CENTRE_Y} 0 0 0 0"
         fingers.append(
             f'    <link name="{finger}">\n'
@@ -184,7 +202,8 @@ def wsg_sdf() -> str:
         "     the figures of tg_drake/robot.py (the WSG 50 data sheet). Frame of `body` (G):\n"
         "     fingers close along ±x, the approach direction is +y, the grasp point is\n"
         f"     {WSG_PAD_CENTRE_Y} m along +y. Finger pads are plain boxes with\n"
-        "     compliant-hydroelastic properties. The two prismatic finger joints are the model's only\n"
+        "     compliant-hydroelastic properties. The two prismatic finger joints are the "
+        "model's only\n"
         "     actuated joints (pydrake's SchunkWsgPositionController expects exactly that).\n"
         "     Do not edit by hand. -->\n"
         '<sdf version="1.9" xmlns:drake="http://drake.mit.edu">\n'

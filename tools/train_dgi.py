@@ -262,7 +262,7 @@ def main(argv=None) -> int:
                     "cv_accuracy": float(np.mean(((p_cv >= 0.5) == y)[data.kinds == k]))}
                 for k in np.unique(data.kinds)}
     per_category = defaultdict(list)
-    for obj, right in zip(data.object_ids, (p_obj >= 0.5) == y):
+    for obj, right in zip(data.object_ids, (p_obj >= 0.5) == y, strict=False):
         per_category[obj.rsplit("_", 1)[0]].append(right)
     results = {
         "n_grasps": int(len(y)),
@@ -380,8 +380,10 @@ def markdown(r: dict, ref: dict | None = None) -> str:
     if ref:
         lines += [
             f"The shipped model learns from labels with {labels_name(r)} (`tools/collect_grasps.py",
-            f"--object-mass`): the same {r['n_grasps']} grasps, executed with each object's inertia",
-            "scaled to that mass, its shape and centre of mass kept. Whether the local shape affords",
+            f"--object-mass`): the same {r['n_grasps']} grasps, executed with each object's "
+            "inertia",
+            "scaled to that mass, its shape and centre of mass kept. Whether the local shape "
+            "affords",
             "a grasp is what the paper's hand-labelled rectangles judged and what its",
             "P(grasp | local shape) means; with the real masses a pan's handle fails under the",
             "pan's 1–2.5 kg whatever its shape, a fact about the object that a 7 mm depth image",
@@ -392,7 +394,8 @@ def markdown(r: dict, ref: dict | None = None) -> str:
         if judged:
             lines += [
                 "Judged by the real-mass labels, the shipped model's top grasps on unseen objects",
-                f"held {100 * judged['top_grasp_accuracy']:.1f} % of the time (the model trained on",
+                f"held {100 * judged['top_grasp_accuracy']:.1f} % of the time (the model "
+                "trained on",
                 f"them: {100 * ref['top_grasp_accuracy']:.1f} %), and it classifies "
                 f"{100 * judged['objectwise_accuracy']:.1f} % of the",
                 "unseen objects' grasps right by those labels (the model trained on them: "
@@ -565,7 +568,8 @@ def summary_markdown(r: dict, ref: dict | None = None) -> list[str]:
         s, o = n["stratified"], n["objectwise"]
         lines += [
             f"- Not local shape ({labels_name(ref or r)}): which object it is explains "
-            f"{100 * s['object_majority']:.1f} % alone, mass and category {100 * o['mass_category']:.1f} % on unseen objects; the "
+            f"{100 * s['object_majority']:.1f} % alone, mass and category "
+            f"{100 * o['mass_category']:.1f} % on unseen objects; the "
             f"DGI with mass and category reaches {100 * s['dgi_mass_category']:.1f} % "
             f"(unseen objects {100 * o['dgi_mass_category']:.1f} %), with gravity's direction "
             f"and the centroid offset {100 * s['dgi_gravity_centroid']:.1f} % "
@@ -599,7 +603,7 @@ def summary_markdown(r: dict, ref: dict | None = None) -> list[str]:
             f"{v['best_by_cv_accuracy']}, reaches {100 * best['cv_accuracy']:.2f} %" + verdict]
         curve = v.get("learning_curve")
         if curve:
-            (f0, e0), (f1, e1) = list(curve.items())[1], list(curve.items())[-1]
+            e0, e1 = list(curve.values())[1], list(curve.values())[-1]
             lines += [
                 "- More grasps of the same kind: trained on half of them, the accuracy on unseen "
                 f"objects is {100 * e0['objectwise_accuracy']:.1f} %, on all "

@@ -49,7 +49,8 @@ def test_training_set_computes_features_of_ok_records_only(cup):
     scene = scene_grasps(cup, "sideways", seed=0)
     records = [{"object": "cup_01", "pose": "sideways", "kind": str(k), "part": int(p),
                 "X_WG": X.ravel().tolist(), "status": "ok", "success": bool(i % 2)}
-               for i, (X, k, p) in enumerate(zip(scene.X_WG[:6], scene.kinds, scene.parts))]
+               for i, (X, k, p) in enumerate(zip(scene.X_WG[:6], scene.kinds, scene.parts,
+                                                 strict=False))]
     records.append({"object": "cup_01", "pose": "sideways", "status": "sim_error",
                     "reason": "object fell through the table during close"})
     data = training_set(records, seed=0)

@@ -12,11 +12,24 @@ from tg_drake.errors import KernelError
 from tg_drake.kernels import synthetic
 from tg_drake.kernels.database import KernelDatabase, prepare_cloud
 from tg_drake.kernels.graph import (
-    LabelledCloud, cloud_transition, knn_graph, object_size, size_normalised, transition_matrix,
-    validate_cloud, voxel_resample)
+    LabelledCloud,
+    cloud_transition,
+    knn_graph,
+    object_size,
+    size_normalised,
+    transition_matrix,
+    validate_cloud,
+    voxel_resample,
+)
 from tg_drake.kernels.prior import category_priors, is_correct, true_category_rank
 from tg_drake.kernels.propagation import (
-    LshProjections, graph_features, lsh, normalise, one_hot, propagation_hashes)
+    LshProjections,
+    graph_features,
+    lsh,
+    normalise,
+    one_hot,
+    propagation_hashes,
+)
 from tg_drake.types import CATEGORIES
 
 SPACING = 0.05  # voxel size of the test clouds as a fraction of the object's size: a few

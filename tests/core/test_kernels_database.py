@@ -20,7 +20,7 @@ def database():
 def test_shipped_database_matches_the_library_and_the_paper_parameters(database):
     library = load_library()
     assert set(database.object_ids.tolist()) == set(library)
-    for obj_id, cat in zip(database.object_ids, database.categories):
+    for obj_id, cat in zip(database.object_ids, database.categories, strict=True):
         assert CATEGORIES[cat] == library[obj_id].category
     assert (database.k, database.spacing) == (4, SPACING)
     # w is cross-validated from the paper's 1e-4 up to 0.1 (tools/build_kernel_db.py).

@@ -59,7 +59,7 @@ def test_kernel_values_match_grakel(graphs, T):
     seed = 1234
     gk = grakel.kernels.Propagation(t_max=T + 1, w=BIN_WIDTH, M="TV", random_state=seed)
     data = [[(tr > 0).toarray().astype(float), dict(enumerate(c.labels.tolist())), {},
-             tr.toarray()] for c, tr in zip(clouds, transitions)]
+             tr.toarray()] for c, tr in zip(clouds, transitions, strict=True)]
     k_grakel = gk.fit_transform(data)
     ours = graph_features(transitions, [c.labels for c in clouds],
                           grakel_projections(seed, T + 1, 5, BIN_WIDTH)).kernel()[T]

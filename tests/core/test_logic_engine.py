@@ -44,7 +44,7 @@ def test_fig1_cup_category_by_hand(specific):
     # cup = .56 (rule silent .6, or says cup .3) + .01 * .3 = .507,
     # pan = .02 (.6 + .1) + .01 * .1 = .015.
     answer = specific.query(FIG1_CUP)
-    c = dict(zip(CATEGORIES, answer.category))
+    c = dict(zip(CATEGORIES, answer.category, strict=False))
     assert c["cup"] == pytest.approx(0.507 / 0.522, abs=EXACT)
     assert c["pan"] == pytest.approx(0.015 / 0.522, abs=EXACT)
     assert c["cup"] >= 0.9  # the paper: 0.98.
@@ -57,7 +57,7 @@ def test_fig1_cup_tasks_by_hand(specific):
     # only as unusual (0.1); a pan affords all five. pourOut (empty) and p&pInSideways (open
     # container) are impossible. pass = 1 / (3 + 2 (0.1 P(cup) + P(pan))).
     answer = specific.query(FIG1_CUP)
-    t = dict(zip(TASKS, answer.task))
+    t = dict(zip(TASKS, answer.task, strict=False))
     p_cup, p_pan = 0.507 / 0.522, 0.015 / 0.522
     lead = 1.0 / (3.0 + 2.0 * (0.1 * p_cup + p_pan))
     for task in ("pass", "p&pOn", "p&pInUpright"):
@@ -81,7 +81,7 @@ def test_general_theory_gives_the_same_argmax_on_the_paper_examples(specific, ge
     cup_s, cup_g = specific.query(FIG1_CUP), general.query(FIG1_CUP)
     assert CATEGORIES[np.argmax(cup_s.category)] == CATEGORIES[np.argmax(cup_g.category)] == "cup"
     # The paper's general figure: cup 0.93, pot 0.05, pan 0.02 (pot survives: no one-handle rule).
-    g = dict(zip(CATEGORIES, cup_g.category))
+    g = dict(zip(CATEGORIES, cup_g.category, strict=False))
     assert g["pot"] > 0 and g["can"] == 0.0
     leading = {TASKS[i] for i in np.flatnonzero(np.isclose(cup_g.task, cup_g.task.max()))}
     assert leading == {"pass", "p&pOn", "p&pInUpright"}
@@ -159,8 +159,8 @@ def test_every_distribution_sums_to_one_on_random_scenes(specific, general):
         signature = containers if rng.uniform() < 0.6 else tools
         parts = {p: float(rng.choice([1.0, rng.uniform(0.5, 1.0)])) if p in signature
                  else float(rng.choice([0.0, rng.uniform(0.0, 0.3)])) for p in PART_LABELS}
-        pose = dict(zip(POSES, rng.dirichlet(np.ones(3))))
-        prior = dict(zip(CATEGORIES, rng.dirichlet(np.full(len(CATEGORIES), 0.5))))
+        pose = dict(zip(POSES, rng.dirichlet(np.ones(3)), strict=False))
+        prior = dict(zip(CATEGORIES, rng.dirichlet(np.full(len(CATEGORIES), 0.5)), strict=True))
         task = None if rng.uniform() < 0.5 else str(rng.choice(TASKS))
         obs = Observations(parts=parts, pose=pose, category_prior=prior, task=task,
                            containment={"empty": float(rng.uniform())})
@@ -179,7 +179,7 @@ def test_every_distribution_sums_to_one_on_random_scenes(specific, general):
 def test_non_exclusive_mode_normalises_marginals():
     engine = LogicEngine(TheoryConfig(exclusive=False))
     answer = engine.query(FIG1_CUP)
-    c = dict(zip(CATEGORIES, answer.category))
+    c = dict(zip(CATEGORIES, answer.category, strict=False))
     # Marginals given "compatible" (can and pot ruled out; prior cup, pan or nothing: .59):
     # P(cup) = (.56 + .01 * .4 * .75 + .02 * .4 * .75) / .59, P(pan) = (.02 + .57 * .4 * .25) / .59.
     cup, pan = (0.56 + 0.003 + 0.006) / 0.59, (0.02 + 0.57 * 0.1) / 0.59

@@ -98,7 +98,7 @@ def test_annotated_disjunction_is_recovered(small_rules):
             for i, c in enumerate(labels)]
     result = fit(data, model="category", directory=small_rules)
     (clause,) = result.clauses
-    for learned, p in zip(clause.after, TRUE_CATEGORY.values()):
+    for learned, p in zip(clause.after, TRUE_CATEGORY.values(), strict=False):
         assert abs(learned - p) < TOLERANCE, (clause.after, TRUE_CATEGORY)
 
 

@@ -59,9 +59,10 @@ def test_compiled_equals_plain_problog_on_random_scenes():
         parts = {p: float(rng.choice([0.0, 1.0, rng.uniform(0.2, 1.0)])) for p in PART_LABELS}
         parts["usable_area"] = 0.0 if i % 3 else 1.0
         obs = Observations(
-            parts=parts, pose=dict(zip(POSES, rng.dirichlet(np.ones(3)))),
+            parts=parts, pose=dict(zip(POSES, rng.dirichlet(np.ones(3)), strict=False)),
             containment={"empty": float(rng.uniform())},
-            category_prior=dict(zip(CATEGORIES, rng.dirichlet(np.ones(len(CATEGORIES))))),
+            category_prior=dict(zip(CATEGORIES, rng.dirichlet(np.ones(len(CATEGORIES))),
+                                    strict=False)),
             task=None if i % 2 else str(rng.choice(TASKS)))
         config = TheoryConfig(category=("specific", "general")[i % 2],
                               grasp=("specific", "general")[(i // 2) % 2],

@@ -12,8 +12,13 @@ from tg_drake.errors import PerceptionError
 from tg_drake.perception import synthetic as S
 from tg_drake.perception.completion import circle_test, complete
 from tg_drake.perception.config import CompletionConfig
-from tg_drake.perception.geometry import (Intrinsics, estimate_normals, inverse,
-                                          make_transform, transform)
+from tg_drake.perception.geometry import (
+    Intrinsics,
+    estimate_normals,
+    inverse,
+    make_transform,
+    transform,
+)
 from tg_drake.perception.pipeline import describe_cloud, describe_object
 from tg_drake.perception.segmentation import segment_depth
 

@@ -8,8 +8,7 @@ import pytest
 from grasp_helpers import GRASP_POINT, grasp_pose
 from pydrake.math import RigidTransform, RotationMatrix
 
-from tg_drake.planning.ik import (CONSTRAINT_TOLERANCE, clearance, make_arm_plant,
-                                  solve_ik_seeds)
+from tg_drake.planning.ik import CONSTRAINT_TOLERANCE, clearance, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.planner import PlannerConfig, place_pose, plan_pick_and_place
 from tg_drake.planning.trajectory import IIWA_VELOCITY_LIMITS
 from tg_drake.robot import IIWA_HOME
@@ -306,7 +305,7 @@ def test_a_steep_grasp_far_out_is_also_tried_leaning_back_towards_the_robot():
     variants = approach_variants(X, config)
     assert len(variants) == 1 + len(config.top_tilts)
     p_grasp = X[:3, 3] + GRASP_POINT * X[:3, 1]
-    for V, tilt in zip(variants[1:], config.top_tilts):
+    for V, tilt in zip(variants[1:], config.top_tilts, strict=False):
         # Same grasp point and closing axis; the wrist (−y_G) leans back towards the robot at
         # the origin by the tilt.
         np.testing.assert_allclose(V[:3, 3] + GRASP_POINT * V[:3, 1], p_grasp, atol=1e-12)
@@ -424,7 +423,7 @@ def test_place_variants_turn_the_object_about_the_vertical_through_its_centre():
     variants = _place_variants(X, PlannerConfig())
     assert len(variants) == len(PlannerConfig().place_yaws)
     np.testing.assert_allclose(variants[0], X, atol=1e-12)  # the kept orientation first
-    for V, yaw in zip(variants, PlannerConfig().place_yaws):
+    for V, yaw in zip(variants, PlannerConfig().place_yaws, strict=False):
         np.testing.assert_allclose(V[:3, 3], X[:3, 3])
         np.testing.assert_allclose(V[2, :3], X[2, :3], atol=1e-12)  # heights of the axes kept
         turn = V[:3, :3] @ X[:3, :3].T

@@ -7,8 +7,14 @@ import pytest
 from pydrake.math import RigidTransform
 
 from tg_drake.planning.ik import CONSTRAINT_TOLERANCE, clearance, make_arm_plant, solve_ik
-from tg_drake.planning.trajectory import (IIWA_VELOCITY_LIMITS, SegmentConfig, SegmentLimits,
-                                          StraightLine, plan_segment, shifted)
+from tg_drake.planning.trajectory import (
+    IIWA_VELOCITY_LIMITS,
+    SegmentConfig,
+    SegmentLimits,
+    StraightLine,
+    plan_segment,
+    shifted,
+)
 
 # The arm reaching forward and low, turned 0.7 rad to either side; a post between the two
 # postures, in the way of the gripper (at about 0.39 m height) when it swings across.

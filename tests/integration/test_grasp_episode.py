@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from tg_drake.grasping.dgi import FINGERTIP_Y, PAD_CENTER_Y
-from tg_drake.simulation.episode import EpisodeConfig, GraspWorld, run_grasp_batch, scripted_targets
 from tg_drake.outcome import CLOSED_ON_AIR
+from tg_drake.simulation.episode import EpisodeConfig, GraspWorld, run_grasp_batch, scripted_targets
 
 CYLINDER_SDF = """<?xml version="1.0"?>
 <sdf version="1.9" xmlns:drake="http://drake.mit.edu">

@@ -19,14 +19,19 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantValueSource
 
-from tg_drake.objects import get_object
+from tg_drake.objects import box_centre, get_object
 from tg_drake.scenario import ObjectPlacement, Scenario
 from tg_drake.station import add_station, placement_pose
-from tg_drake.objects import box_centre
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.supervisor import MonitorModel, Supervisor, SupervisorConfig
-from tg_drake.types import (PART_LABELS, GraspCandidates, GraspSemantics, ObjectDescription,
-                            PartBox, SceneDescription)
+from tg_drake.types import (
+    PART_LABELS,
+    GraspCandidates,
+    GraspSemantics,
+    ObjectDescription,
+    PartBox,
+    SceneDescription,
+)
 
 PLACE_XY = (0.75, -0.25)  # [m] world
 START = 0.1  # [s] the supervisor's first check

@@ -2,8 +2,9 @@
 
 Each case builds a MultibodyPlant with the table top of tg_drake/table.py (a box, compliant
 hydroelastic: modulus 1e7 Pa, resolution hint 0.1 m, Hunt–Crossley dissipation 3 s/m, friction 0.5)
-and the object's SDF (rigid hydroelastic mesh, friction 1.0), places the object at X_WO = X_WT · X_TO
-from library.yaml and simulates 2 s with SAP. The object must not drift or tip, and its contact with
+and the object's SDF (rigid hydroelastic mesh, friction 1.0), places the object at
+X_WO = X_WT · X_TO from library.yaml and simulates 2 s with SAP. The object must not drift or
+tip, and its contact with
 the table must be a hydroelastic contact surface (not point-pair fallback).
 
 The default run takes one object per category and pose (the first instance); the full sweep of
@@ -195,7 +196,8 @@ def test_objects_render_in_colour_depth_and_labels():
         assert 3.0 - top - 1e-3 <= depth[mask].min() <= 3.0 + 1e-3, obj.id
 
 
-if __name__ == "__main__":  # the timings for the report: python tests/integration/test_objects_rest.py
+# The timings for the report: python tests/integration/test_objects_rest.py
+if __name__ == "__main__":
     total = 0.0
     for obj_id, pose in CASES:
         r = rest_on_table(obj_id, pose)

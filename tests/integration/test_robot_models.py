@@ -16,8 +16,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from tg_drake import robot
 from tg_drake.errors import ScenarioError
-from tg_drake.robot_plants import add_scenario_models, model_directives
-from tg_drake.robot_plants import default_directives
+from tg_drake.robot_plants import add_scenario_models, default_directives, model_directives
 from tg_drake.scenario import X_7G, Scenario
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -120,7 +119,7 @@ def test_wsg_pads_and_body(station_robot, opening):
     wsg = plant.GetModelInstanceByName("wsg")
     plant.SetPositions(context, wsg, [-opening / 2, opening / 2])
     expected = robot.wsg_pad_boxes(opening)
-    for name, (centre, size) in zip(robot.WSG_FINGERS, expected):
+    for name, (centre, size) in zip(robot.WSG_FINGERS, expected, strict=False):
         ((c, s),) = _boxes_in_G(plant, scene_graph, context, name)
         np.testing.assert_allclose(c, centre, atol=1e-12)
         np.testing.assert_allclose(s, size, atol=1e-12)

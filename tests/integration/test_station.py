@@ -19,7 +19,8 @@ def test_iiwa_holds_a_commanded_posture_within_1mm(station):
     plant = st.plant
     plant_context = plant.GetMyMutableContextFromRoot(context)
     q_cmd = np.array([0.3, 0.5, -0.2, -1.5, 0.4, 0.9, 0.2])
-    diagram.GetInputPort("iiwa.desired_state").FixValue(context, np.concatenate([q_cmd, np.zeros(7)]))
+    diagram.GetInputPort("iiwa.desired_state").FixValue(context,
+                                                        np.concatenate([q_cmd, np.zeros(7)]))
     diagram.GetInputPort("wsg.position").FixValue(context, [0.05])
     Simulator(diagram, context).AdvanceTo(3.0)
     X_W7 = flange_pose(plant, plant_context)
@@ -54,9 +55,11 @@ def test_camera_sees_the_table_at_the_right_depth(station):
     X_WC = diagram.GetOutputPort("camera0.camera_pose").Eval(context)
     info = st.cameras["camera0"].info
     assert depth.shape == (info.height(), info.width())
-    # The ray through the image centre hits the table plane z = 0 at the depth along the optical axis.
+    # The ray through the image centre hits the table plane z = 0 at the depth along the optical
+    # axis.
     v, u = info.height() // 2, info.width() // 2
-    ray_C = np.array([(u - info.center_x()) / info.focal_x(), (v - info.center_y()) / info.focal_y(), 1])
+    ray_C = np.array([(u - info.center_x()) / info.focal_x(),
+                      (v - info.center_y()) / info.focal_y(), 1])
     ray_W = X_WC.rotation() @ ray_C
     expected_depth = -X_WC.translation()[2] / ray_W[2]
     assert depth[v, u] == pytest.approx(expected_depth, abs=2e-3)  # 2 mm: depth rendering precision

@@ -203,7 +203,7 @@ def test_new_semantics_rerank_without_rescoring_the_shapes(model):
         rankings.append(port.Eval(context))
     assert calls == [2]
     p_local = model.p_grasp(scene.objects[0].p_W, poses)
-    for ranked, first in zip(rankings, ("top", "middle")):
+    for ranked, first in zip(rankings, ("top", "middle"), strict=False):
         assert ranked.parts[0] == part_index(first)
         np.testing.assert_allclose(np.sort(ranked.p_local), np.sort(p_local), atol=1e-12)
     # A new scene scores its shapes again.

@@ -11,8 +11,13 @@ from pydrake.systems.analysis import Simulator
 from tg_drake.planning.planner import PlannerConfig
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.plan_messages import PlanRequest, PlanStatus
-from tg_drake.types import (PART_LABELS, GraspCandidates, ObjectDescription, PartBox,
-                            SceneDescription)
+from tg_drake.types import (
+    PART_LABELS,
+    GraspCandidates,
+    ObjectDescription,
+    PartBox,
+    SceneDescription,
+)
 
 START = 0.5  # [s] the planner's first event
 Q_MEASURED = np.array([0.1, -0.5, 0.05, -1.8, 0.0, 1.1, 0.2])  # a posture near IIWA_HOME

@@ -59,7 +59,7 @@ def test_one_distribution_per_object_with_neighbours(database):
     prior = system.get_category_prior_output_port().Eval(context)
     assert isinstance(prior, CategoryPrior)
     assert len(prior.distributions) == 2
-    for dist, name in zip(prior.distributions, ["cup", "hammer"]):
+    for dist, name in zip(prior.distributions, ["cup", "hammer"], strict=False):
         assert dist.probabilities.shape == (11,)
         assert dist.probabilities.sum() == pytest.approx(1.0, abs=1e-12)
         assert CATEGORIES[int(np.argmax(dist.probabilities))] == name

@@ -17,10 +17,22 @@ from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource
 from tg_drake.outcome import HandGeometries
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
-from tg_drake.systems.supervisor import (MonitorModel, Outcome, Reason, Status, Supervisor,
-                                         SupervisorConfig)
-from tg_drake.types import (PART_LABELS, GraspCandidates, GraspSemantics, ObjectDescription,
-                            PartBox, SceneDescription)
+from tg_drake.systems.supervisor import (
+    MonitorModel,
+    Outcome,
+    Reason,
+    Status,
+    Supervisor,
+    SupervisorConfig,
+)
+from tg_drake.types import (
+    PART_LABELS,
+    GraspCandidates,
+    GraspSemantics,
+    ObjectDescription,
+    PartBox,
+    SceneDescription,
+)
 
 # No plant: the gate and the re-query policy never read the monitor's geometry.
 NO_MODEL = MonitorModel(HandGeometries(frozenset(), frozenset(), frozenset(), frozenset()),

@@ -18,11 +18,11 @@ from pathlib import Path
 import numpy as np
 
 from tg_drake.bench import Figure, figure
-from tg_drake.evaluation.paper import PAPER
-from tg_drake.perception.bench import object_times_ms
 from tg_drake.evaluation.cli import _run
+from tg_drake.evaluation.paper import PAPER
 from tg_drake.evaluation.suite import load_suite
 from tg_drake.executor import Job, LocalExecutor, run_jobs
+from tg_drake.perception.bench import object_times_ms
 
 N_CASES = 64
 

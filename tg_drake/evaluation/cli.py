@@ -21,8 +21,8 @@ import zlib
 from pathlib import Path
 
 from tg_drake.errors import ScenarioError, unknown_name
-from tg_drake.types import THEORY_VARIANTS as VARIANTS
 from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
+from tg_drake.types import THEORY_VARIANTS as VARIANTS
 
 # Start-up: `tg-drake --help` imports this module, so the suite, scenario, table and job modules
 # (which import pydrake) are imported inside the functions that use them.

@@ -6,7 +6,8 @@ table can be derived again from the records (tg_drake.evaluation.tables).
 
 - synthetic: observations from the labelled mesh (parts certain, pose certain, containment, handle
   count); kernel priors at T = 0 (Label fractions) and T = kernel_T (Manifolds) from one labelled
-  sampling of the mesh per object (seeded by the object and the suite's seed), leave-one-object-out; then every logic method (METHODS) answers category,
+  sampling of the mesh per object (seeded by the object and the suite's seed),
+  leave-one-object-out; then every logic method (METHODS) answers category,
   task (inferred) and, for each ground-truth task given, the pre-grasp part.
 - perceived: the object's depth image ray cast from the default camera's viewpoint and perceived;
   pose and part detection against the truth; then the same queries on observations of each setting.
@@ -35,7 +36,8 @@ from tg_drake.scenario import DgiScorer, LocalOnly, PipelineConfig, Scenario, Ta
 from tg_drake.types import CATEGORIES
 
 # Logic methods (the paper's columns, the paper's two ablations and ours): name → (category/task
-# theory, pre-grasp theory, prior[, "no_interior"]). Theories as (category model, grasp model, exclusive); the pre-grasp
+# theory, pre-grasp theory, prior[, "no_interior"]). Theories as (category model, grasp model,
+# exclusive); the pre-grasp
 # columns keep the specific category model, as the paper's Table "pre-grasp" does.
 METHODS = {
     "plm_uniform": (("specific", "specific", True), ("specific", "specific", True), "uniform"),
@@ -55,7 +57,7 @@ PRIOR_FLOOR = 0.02  # the pipeline's (PipelineConfig.prior_floor): a prior that 
 CONFIDENT_PART = 0.5  # S_REAL: detected parts at least this likely are kept (as certain).
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _engine(category: str, grasp: str, exclusive: bool):
     return LogicEngine(TheoryConfig(category=category, grasp=grasp, exclusive=exclusive))
 
@@ -71,7 +73,7 @@ def _prior(kind: str, priors: dict) -> dict | None:
     if kind == "top":
         p = np.eye(len(CATEGORIES))[int(np.argmax(p))]
     p = (1.0 - PRIOR_FLOOR) * p + PRIOR_FLOOR / len(CATEGORIES)
-    return dict(zip(CATEGORIES, p.tolist()))
+    return dict(zip(CATEGORIES, p.tolist(), strict=True))
 
 
 def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS,
@@ -89,7 +91,7 @@ def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS,
         prior = _prior(prior_kind, priors)
         interior = 0.0 if "no_interior" in flags else observations.interior_seen
 
-        def obs(task=None):
+        def obs(task=None, prior=prior, interior=interior):
             return Observations(parts=observations.parts, pose=observations.pose,
                                 containment=observations.containment, category_prior=prior,
                                 task=task, handles=observations.handles,
@@ -164,7 +166,8 @@ def run_perceived(case) -> list[dict]:
             p for p, v in d.part_probabilities.items() if v > 0)}
         priors = kernel_priors(d.p_W, d.n_W, d.labels, object_id=obj.id, t=case.kernel_T)
     except TgDrakeError as e:  # perception found nothing usable: a failure of every method
-        detection, priors, d = {"found_pose": None, "found_parts": None, "error": str(e)}, None, None
+        detection = {"found_pose": None, "found_parts": None, "error": str(e)}
+        priors, d = None, None
     detection["pose_ok"] = detection["found_pose"] == placement.pose
     detection["parts_ok"] = detection["found_parts"] == sorted(obj.parts)
     records = []

@@ -36,7 +36,8 @@ def _table(measure: str, source: str, cells: dict, unit: str = "%", _key=()) -> 
         if isinstance(cell, dict):
             _table(measure, source, cell, unit, key)
         else:
-            where = ", ".join(f"{what} {k}" for what, k in zip(("row", "column", "entry"), key))
+            where = ", ".join(f"{what} {k}"
+                              for what, k in zip(("row", "column", "entry"), key, strict=False))
             value = int(cell) if unit == "" and float(cell).is_integer() else float(cell)
             FIGURES.append(Figure((measure, *key), value, unit, f"{source}: {measure}, {where}"))
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tg_drake.evaluation.suite import DATASETS
 from tg_drake.evaluation.paper import PAPER
+from tg_drake.evaluation.suite import DATASETS
 from tg_drake.evaluation.tables import CATEGORY_METHODS, LABELS, THRESHOLDS
 
 DPI = 80  # small files for the repository
@@ -39,7 +39,7 @@ def accuracy_plot(tables: dict, path: Path) -> None:
         ours = [tables["category"][d].get(m) for m in CATEGORY_METHODS]
         ax.bar(xs, [v or 0 for v in ours], width, label=DATASETS[d] + " (ours)")
         paper = [PAPER["category"].get(d, {}).get(m) for m in CATEGORY_METHODS]
-        ax.scatter([x for x, p in zip(xs, paper) if p is not None],
+        ax.scatter([x for x, p in zip(xs, paper, strict=False) if p is not None],
                    [p for p in paper if p is not None], marker="_", s=200, color="black",
                    zorder=3, label="paper" if j == 0 else None)
     ax.set_xticks(range(len(CATEGORY_METHODS)), [LABELS[m] for m in CATEGORY_METHODS],
@@ -59,7 +59,7 @@ def ei_plot(tables: dict, key: str, path: Path, title: str) -> None:
     if not rows:
         return
     fig, axes = plt.subplots(1, len(rows), figsize=(3.2 * len(rows), 3.2), squeeze=False)
-    for ax, (d, r) in zip(axes[0], rows.items()):
+    for ax, (d, r) in zip(axes[0], rows.items(), strict=False):
         for m, style in (("plm", "-o"), ("plm_uniform", "--s")):
             ks = list(r[m])
             ax.plot(range(len(ks)), [r[m][k] or 0 for k in ks], style, label=LABELS[m] + " (ours)")
@@ -85,7 +85,7 @@ def pipeline_plot(tables: dict, path: Path) -> None:
     if not rows:
         return
     fig, axes = plt.subplots(1, len(rows), figsize=(4.5 * len(rows), 3.2), squeeze=False)
-    for ax, (d, r) in zip(axes[0], rows.items()):
+    for ax, (d, r) in zip(axes[0], rows.items(), strict=False):
         vs = [v for v in ("local", "pipeline", "pipeline_uniform") if v in r]
         width = 0.8 / len(vs)
         for j, v in enumerate(vs):

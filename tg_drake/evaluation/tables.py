@@ -1,4 +1,5 @@
-"""Every table of the paper's section VI, derived from a sweep's records, beside the paper's figures.
+"""Every table of the paper's section VI, derived from a sweep's records, beside the paper's
+figures.
 
 `compute(records)` → a JSON-able dict of tables; `markdown(tables, command=...)` → tables.md.
 Records are what tg_drake.evaluation.jobs writes (one line of results.jsonl each); a case that
@@ -25,7 +26,8 @@ from tg_drake.evaluation.paper import PAPER
 from tg_drake.evaluation.suite import DATASETS, OURS, VARIANTS
 from tg_drake.types import CATEGORIES, PART_LABELS, TASKS
 
-TIE = 1e-9  # probabilities this close are tied (the circuit's rounding is ~1e-15; records keep 6 digits)
+# Probabilities this close are tied (the circuit's rounding is ~1e-15; records keep 6 digits).
+TIE = 1e-9
 THRESHOLDS = (0.5, 0.4, 0.3)  # P(grasp | local shape) thresholds of the paper's Table "pipeline"
 HELD = ("lifted", "placed")  # outcomes where the object stayed in the hand through the lift
 LOGIC_METHODS = ("plm_uniform", "plm_general_uniform", "plm", "plm_general")
@@ -110,7 +112,8 @@ def detection(records) -> dict:
         us = [x for x in rows if x[0] in ("upright", "sideways")]
         out[dataset] = {"n": len(rows), "pose_accuracy": _pct([x[1] for x in rows]),
                         "part_accuracy": _pct([x[2] for x in rows]),
-                        "upright_sideways": {"n": len(us), "pose_accuracy": _pct([x[1] for x in us]),
+                        "upright_sideways": {"n": len(us),
+                                             "pose_accuracy": _pct([x[1] for x in us]),
                                              "part_accuracy": _pct([x[2] for x in us])}}
     return out
 
@@ -181,11 +184,11 @@ def category(records) -> dict:
             for m in (*LOGIC_METHODS, *ABLATION_METHODS):
                 table[m] = _pct([_method(r, m) is not None and
                                  _argmax_ok(_method(r, m)["category"], t)
-                                 for r, t in zip(logic, truth)])
+                                 for r, t in zip(logic, truth, strict=False)])
             for m in ("plm_uniform", "plm_general_uniform"):
                 table[f"{m}_ties_ok"] = _pct([_method(r, m) is not None and
                                               t in top_set(_method(r, m)["category"])
-                                              for r, t in zip(logic, truth)])
+                                              for r, t in zip(logic, truth, strict=False)])
             table["n"] = len(logic)
         for variant, method in (("pipeline", "plm"), ("pipeline_uniform", "plm_uniform")):
             ex = _executed(rs, variant)
@@ -194,10 +197,10 @@ def category(records) -> dict:
             truth = [CATEGORIES.index(r["truth"]["category"]) for r in ex]
             if variant == "pipeline":
                 table["manifolds"] = _pct([_argmax_ok(_vector(r.get("category_prior"), CATEGORIES),
-                                                      t) for r, t in zip(ex, truth)])
+                                                      t) for r, t in zip(ex, truth, strict=False)])
                 table["n"] = len(ex)
             table[method] = _pct([_argmax_ok(_vector(r.get("category"), CATEGORIES), t)
-                                  for r, t in zip(ex, truth)])
+                                  for r, t in zip(ex, truth, strict=False)])
         out[dataset] = table
     return out
 
@@ -334,7 +337,8 @@ def outcomes(records) -> dict:
                 row[_status(r) if "error" not in r else "error"] += 1
             wall = [r["timings"]["total"] for r in ex if (r.get("timings") or {}).get("total")]
             out.setdefault(dataset, {})[variant] = {
-                "n": len(ex), **{k: _pct([_status(r) in v for r in ex]) for k, v in reached.items()},
+                "n": len(ex),
+                **{k: _pct([_status(r) in v for r in ex]) for k, v in reached.items()},
                 "failures": _failures(ex),
                 "per_category": {c: dict(per_category[c]) for c in CATEGORIES if c in per_category},
                 "wall_seconds_median": round(float(np.median(wall)), 2) if wall else None}
@@ -352,7 +356,7 @@ def _failures(rs) -> dict:
 def ablations(cat: dict, tsk: dict, pre: dict) -> dict:
     top, excl, interior = {}, {}, {}
     for dataset in tsk:
-        def row(m):
+        def row(m, dataset=dataset):
             return {"category": cat[dataset].get(m), "task_E0": tsk[dataset][m]["E0"],
                     "pregrasp_E0": pre.get(dataset, {}).get(m, {}).get("E0")}
         top[dataset] = {"full_prior": row("plm"), "top_category": row("plm_top")}
@@ -493,7 +497,8 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
         if ex:
             L += [f"{name(d)}, executed: E_0 over runs whose planner found a grasp (part in Gt and "
                   "the object held through the lift); the logic's argmax part alone over all runs:",
-                  "", "| variant | runs | valid | E0 executed | E0 logic |", "|---|---|---|---|---|"]
+                  "", "| variant | runs | valid | E0 executed | E0 logic |",
+                  "|---|---|---|---|---|"]
             for v in ex:
                 x = r[v]
                 L.append(f"| {LABELS[v]} | {x['n_runs']} | {x['n_valid']} | "

@@ -31,10 +31,10 @@ def dgi_us_per_hypothesis() -> Figure:
         if len(X_WG) == 0:
             continue
 
-        def batch():
+        def batch(p_W=p_W, X_WG=X_WG):
             model.p_grasp(p_W, X_WG)
 
-        def one_at_a_time():
+        def one_at_a_time(p_W=p_W, X_WG=X_WG):
             for X in X_WG:
                 f = clf.svm_.decision_function(model.features(p_W, X))
                 platt_probability(f, clf.A_, clf.b_)

@@ -35,6 +35,7 @@ from tg_drake.grasping.hypotheses import (
 from tg_drake.objects import LibraryObject, get_object, sample_surface
 
 KINDS = ("box", "perturbed", "random")
+DEFAULT_DGI = DgiConfig()  # the default features (frozen: one shared default is safe)
 
 
 @dataclass(frozen=True)
@@ -104,7 +105,7 @@ def scene_grasps(obj: LibraryObject, pose: str, *, seed: int,
     p_O, n_O, labels = sample_surface(obj, spacing=0.003, rng=rng)
     boxes = [X_WO @ X_OB for X_OB, _ in part_boxes(p_O, labels).values()]
     halves = [h for _, h in part_boxes(p_O, labels).values()]
-    box = np.concatenate([box_grasps(X, h) for X, h in zip(boxes, halves)])
+    box = np.concatenate([box_grasps(X, h) for X, h in zip(boxes, halves, strict=True)])
     perturbed = perturb_grasps(np.repeat(box, config.perturbed_per_box, axis=0), rng,
                                position_std=config.position_std, angle_std=config.angle_std)
     p_W = p_O @ X_WO[:3, :3].T + X_WO[:3, 3]
@@ -156,7 +157,7 @@ def training_order(records: list[dict]) -> list[dict]:
     return [r for _, rows in _by_scene(records) for r in rows]
 
 
-def training_set(records: list[dict], *, seed: int, config: DgiConfig = DgiConfig(),
+def training_set(records: list[dict], *, seed: int, config: DgiConfig = DEFAULT_DGI,
                  sampling: SamplingConfig = SamplingConfig()) -> TrainingSet:
     """Features and labels of the executed grasps with status "ok" (see collect_grasps.py), in
     the order of `training_order`."""

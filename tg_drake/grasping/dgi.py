@@ -32,8 +32,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from tg_drake.errors import GraspingError
-from tg_drake.robot import (WSG_FINGERTIP_Y, WSG_MAX_OPENING, WSG_PAD_CENTRE_Y, WSG_PAD_SIZE,
-                            WSG_PALM_Y)
+from tg_drake.robot import (
+    WSG_FINGERTIP_Y,
+    WSG_MAX_OPENING,
+    WSG_PAD_CENTRE_Y,
+    WSG_PAD_SIZE,
+    WSG_PALM_Y,
+)
 
 # --- WSG 50 geometry in the gripper frame G [m] (tg_drake.robot) -------------------------------
 CLOSING_AXIS = 0  # index of x_G: the fingers close along ±x_G.

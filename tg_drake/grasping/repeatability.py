@@ -135,7 +135,7 @@ def analyse(rows: list[dict], *, groups: Callable[[dict], list[str]],
         weighted.extend((w, a) for a in agree)
         for g in groups(first):
             per_group[g].extend(agree)
-        for name, t in trials.items():
+        for t in trials.values():
             if t["success"] == original:
                 continue
             if first.get("original_held") and held(t):

@@ -20,11 +20,20 @@ import scipy.sparse as sp
 
 from tg_drake.errors import KernelError, unknown_name
 from tg_drake.kernels.graph import (
-    K_NEIGHBOURS, LabelledCloud, cloud_transition, size_normalised, validate_cloud,
-    voxel_resample)
+    K_NEIGHBOURS,
+    LabelledCloud,
+    cloud_transition,
+    size_normalised,
+    validate_cloud,
+    voxel_resample,
+)
 from tg_drake.kernels.prior import N_NEIGHBOURS, category_priors
 from tg_drake.kernels.propagation import (
-    FeatureCounts, LshProjections, graph_features, propagation_hashes)
+    FeatureCounts,
+    LshProjections,
+    graph_features,
+    propagation_hashes,
+)
 from tg_drake.types import CATEGORIES, PART_LABELS, CategoryDistribution
 
 FORMAT_VERSION = 3  # 3: clouds scaled to unit size before resampling (spacing relative).
@@ -272,7 +281,8 @@ class KernelDatabase:
             matrices = [
                 sp.csc_matrix((cnt, gid, np.concatenate([[0], np.cumsum(nnz)])),
                               shape=(n_graphs, len(voc)))
-                for voc, nnz, gid, cnt in zip(vocabularies, column_nnz, graph_ids, counts)]
+                for voc, nnz, gid, cnt in zip(vocabularies, column_nnz, graph_ids, counts,
+                                              strict=False)]
             return cls(
                 object_ids=data["object_ids"].astype(str),
                 categories=data["categories"].astype(np.int64),

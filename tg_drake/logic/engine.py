@@ -87,6 +87,7 @@ EVIDENCE_FLOOR = 1e-12
 MIN_SHARE = 0.01
 MAX_REASONS = 6  # reasons listed per answer.
 MAX_ANSWERS = 3  # answers explained per query (those with probability > 0).
+DEFAULT_THEORY = TheoryConfig()  # the default variant (frozen: one shared default is safe)
 
 
 @dataclass
@@ -110,7 +111,7 @@ class LogicAnswer:
             return {p: float(values[i]) for i, p in enumerate(names) if p in self.observed_parts}
         if query == "task" and self.given_task is not None:
             return {self.given_task: 1.0}
-        return {n: float(v) for n, v in zip(names, values)}
+        return {n: float(v) for n, v in zip(names, values, strict=True)}
 
     def to_semantics(self, target: int = 0) -> GraspSemantics:
         return GraspSemantics(
@@ -385,7 +386,7 @@ def _compiled(key) -> CompiledTheory:
     return CompiledTheory(config, Path(directory))
 
 
-def compiled_theory(config: TheoryConfig = TheoryConfig(),
+def compiled_theory(config: TheoryConfig = DEFAULT_THEORY,
                     directory: Path | None = None) -> CompiledTheory:
     """The compiled theory for a variant, compiled once per process (and again if a theory file
     changes)."""
@@ -414,7 +415,7 @@ class LogicQueryConfig:
 class LogicEngine:
     """Answers the three queries for scenes, on a theory compiled once."""
 
-    def __init__(self, config: TheoryConfig = TheoryConfig(), *,
+    def __init__(self, config: TheoryConfig = DEFAULT_THEORY, *,
                  directory: Path | None = None):
         self.config = config
         self.theory = compiled_theory(config, directory)
@@ -430,7 +431,7 @@ class LogicEngine:
         return answer
 
 
-def reference_query(obs: Observations, config: TheoryConfig = TheoryConfig(), *,
+def reference_query(obs: Observations, config: TheoryConfig = DEFAULT_THEORY, *,
                     directory: Path | None = None, with_evidence: bool = False) -> LogicAnswer:
     """The same answers from plain ProbLog: the scene as a program, ground, compiled and
     evaluated once per query (no explanations). `with_evidence` also computes P(e) (one more

@@ -321,7 +321,7 @@ def _program(model: str, variant: str, directory: Path | None):
         p = _probabilities(source)
         q = _stick(p)
         chain, previous = [], []
-        for i, (head, qi) in enumerate(zip(heads, q)):
+        for i, (head, qi) in enumerate(zip(heads, q, strict=False)):
             choice = Term(f"lfi_{k}_{i}", *variables)
             chain.append(choice.functor)
             weight = Term("t", Constant(_inside(qi)))
@@ -460,16 +460,17 @@ def fit(interpretations: Sequence[Interpretation], *, model: str = "grasp",
         log_likelihood = float(lfi.run())
     except InconsistentEvidenceError as e:
         raise RuleError(f"inconsistent evidence in the interpretations: {e}") from None
-    learned = {str(name.functor): _weight(w) for name, w in zip(lfi.names, lfi._weights)}
+    learned = {str(name.functor): _weight(w)
+               for name, w in zip(lfi.names, lfi._weights, strict=False)}
     clauses = []
-    for source_clause, chain, n in zip(tunables, functors, counts):
+    for source_clause, chain, n in zip(tunables, functors, counts, strict=False):
         before = _probabilities(source_clause)
         if n == 0:
             after = before
         else:
-            mle = _unstick([learned.get(f, q) for f, q in zip(chain, _stick(before))])
+            mle = _unstick([learned.get(f, q) for f, q in zip(chain, _stick(before), strict=False)])
             after = [(n * a + prior_strength * b) / (n + prior_strength)
-                     for a, b in zip(mle, before)]
+                     for a, b in zip(mle, before, strict=False)]
         clauses.append(LearnedClause(source_clause.file, source_clause.line, source_clause.text,
                                      before, _rounded(after), n))
     return FitResult(model, variant, clauses, log_likelihood, int(lfi.iteration), len(kept),
@@ -567,7 +568,8 @@ def learned_text(result: FitResult, *, header: Sequence[str], directory: Path | 
             end += 1
         values = iter(c.after)
         for j in range(start, min(end + 1, len(lines))):
-            lines[j] = _NUMBER.sub(lambda m: _fmt(next(values, float(m.group(1)))), lines[j])
+            lines[j] = _NUMBER.sub(lambda m, values=values: _fmt(next(values, float(m.group(1)))),
+                                  lines[j])
     head = [f"% {h}" if h else "%" for h in header]
     return "\n".join(head + ["%"] + lines) + "\n"
 

@@ -223,7 +223,7 @@ class Observations:
                 raise RuleError(f"prior_floor must lie in [0, 1], got {prior_floor}",
                                 field="prior_floor")
             p = (1.0 - prior_floor) * p + prior_floor / len(CATEGORIES)
-            category_prior = dict(zip(CATEGORIES, p.tolist()))
+            category_prior = dict(zip(CATEGORIES, p.tolist(), strict=True))
         return cls(parts=dict(obj.part_probabilities), pose=dict(obj.pose_likelihood),
                    containment=None if obj.containment is None else {obj.containment: 1.0},
                    category_prior=category_prior, task=task or None,
@@ -377,7 +377,8 @@ def observation_clauses(obs: Observations) -> list[Term]:
                "prior": obs.category_vector(), "task": obs.task_vector()}
     for group, heads, body in _ad_groups():
         p = vectors[group]
-        kept = [h.with_probability(Constant(float(pi))) for h, pi in zip(heads, p) if pi > 0]
+        kept = [h.with_probability(Constant(float(pi)))
+                for h, pi in zip(heads, p, strict=False) if pi > 0]
         if kept:
             clauses.append(AnnotatedDisjunction(kept, body if body is not None else Term("true")))
     for part in obs.collisions:

@@ -227,7 +227,7 @@ def compile_clauses(clauses: list[SourceClause]) -> tuple[list[Term], dict[tuple
                             "> 1", file=source.file, line=source.line)
         rest = 1.0
         previous: list[Term] = []
-        for i, (head, pi) in enumerate(zip(heads, p)):
+        for i, (head, pi) in enumerate(zip(heads, p, strict=False)):
             q = min(1.0, pi / rest) if rest > 1e-15 else 0.0
             fact = Term("ad_choice", Constant(k), Constant(i), variables)
             choices[(k, i)] = Choice(k, i, q)

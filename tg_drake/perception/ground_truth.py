@@ -63,7 +63,7 @@ def open_top(p_O: np.ndarray, labels: np.ndarray) -> bool:
     return bool(top - q[central, 2].max() >= OPEN_TOP_DEPTH * height)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def library_open_top(obj_id: str, seed: int = 0) -> bool:
     """`open_top` of a library object, on a sampling of 4,000 surface points drawn with `seed`
     (a property of the object, not of a run: the default sampling is the one the labels use)."""

@@ -131,8 +131,6 @@ def segment_parts(c: Completion, top_sign: float, cfg: PartConfig | None = None)
     long_handle = _long_handle(c, cfg)
     R_TO = _object_frame(c, top_sign, long_handle)
     q = (c.p_T - c.p_TA) @ R_TO  # points in O's axes, origin on the axis.
-    lo, hi = q.min(axis=0), q.max(axis=0)
-    extents = hi - lo
     is_tool = False
     if not c.vertical:
         # The visible points' profile: a tool lying on the table need not be symmetric about

@@ -21,11 +21,16 @@ from pydrake.multibody.tree import SpatialInertia
 from pydrake.planning import RobotDiagramBuilder
 from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 
-from tg_drake.robot import (IIWA_HOME, IIWA_JOINT_NAMES, WSG_BODY, WSG_FINGER_JOINTS, WSG_FINGERS,
-                            WSG_MAX_OPENING)
+from tg_drake.robot import (
+    IIWA_HOME,
+    IIWA_JOINT_NAMES,
+    WSG_BODY,
+    WSG_FINGER_JOINTS,
+    WSG_FINGERS,
+    WSG_MAX_OPENING,
+)
 from tg_drake.robot_plants import add_scenario_models
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, add_table
-
 
 # The scenario's models in the planning plant: the robot and the gripper (the table is added from
 # the scenario's table_size); loose objects become obstacles if at all.

@@ -47,10 +47,21 @@ from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
-from tg_drake.planning.trajectory import (SegmentConfig, SegmentLimits, StraightLine,
-                                          plan_segment, shifted)
-from tg_drake.robot import (IIWA_HOME, WSG_FINGERTIP_Y, WSG_GRASP_POINT_G, WSG_MAX_OPENING,
-                            WSG_PAD_SIZE, WSG_PALM_Y)
+from tg_drake.planning.trajectory import (
+    SegmentConfig,
+    SegmentLimits,
+    StraightLine,
+    plan_segment,
+    shifted,
+)
+from tg_drake.robot import (
+    IIWA_HOME,
+    WSG_FINGERTIP_Y,
+    WSG_GRASP_POINT_G,
+    WSG_MAX_OPENING,
+    WSG_PAD_SIZE,
+    WSG_PALM_Y,
+)
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, SceneDescription
 
 
@@ -131,8 +142,8 @@ class PlannerConfig:
     # logic moves on to the next part).
     max_length_ratio: float = 2.0  # fingers do not close along a part's length when it is this
     # many times longer than its other extents (a knife's handle, taken end to end, slipped out).
-    place_yaws: list[float] = field(
-        default_factory=lambda: [0.0, 60.0, -60.0, 120.0, -120.0, 180.0])  # [deg] turns of the object
+    place_yaws: list[float] = field(  # [deg] turns of the object
+        default_factory=lambda: [0.0, 60.0, -60.0, 120.0, -120.0, 180.0])
     # about the vertical tried at the place, in order (the first one that can be planned).
     max_candidates_per_part: int = 12  # candidates per part that reach the inverse kinematics
     # before the part is given up (those the cheap geometric checks refuse do not count).

@@ -29,9 +29,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.math import BsplineBasis, RigidTransform
-from pydrake.multibody.inverse_kinematics import (MinimumDistanceLowerBoundConstraint,
-                                                  OrientationConstraint,
-                                                  PointToLineDistanceConstraint)
+from pydrake.multibody.inverse_kinematics import (
+    MinimumDistanceLowerBoundConstraint,
+    OrientationConstraint,
+    PointToLineDistanceConstraint,
+)
 from pydrake.planning import KinematicTrajectoryOptimization
 from pydrake.solvers import Solve
 from pydrake.trajectories import BsplineTrajectory
@@ -174,7 +176,7 @@ def _solve_with_refinement(arm, q0, q1, guess_knots, *, min_distance, limits, co
     # accepted solutions may sit a fraction of a millimetre inside the bound).
     samples = list(np.linspace(0.0, 1.0, config.collision_samples + 2)[1:-1])
     guess = _guess(arm, guess_knots, config.num_control_points, limits)
-    for attempt in range(config.max_refinements + 1):
+    for _ in range(config.max_refinements + 1):
         trajopt, result = _solve(arm, q0, q1, samples, guess, min_distance=min_distance,
                                  limits=limits, config=config, line=line)
         if not satisfies_constraints(result, trajopt.prog()):

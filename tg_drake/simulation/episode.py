@@ -177,7 +177,7 @@ class GraspScript(LeafSystem):
     def _calc_desired_state(self, context, output):
         R_GW = context.get_numeric_parameter(self._R_GW_index).value().reshape(3, 3)
         targets = scripted_targets(context.get_time(), self._config, R_GW)
-        q, v = zip(*(targets[name] for name in self._joints))
+        q, v = zip(*(targets[name] for name in self._joints), strict=False)
         output.SetFromVector(np.concatenate([q, v]))
 
 

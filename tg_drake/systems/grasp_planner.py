@@ -23,7 +23,6 @@ from tg_drake.scenario import Scenario
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
 from tg_drake.types import GraspCandidates, SceneDescription
 
-
 # Without a connected ``plan_request`` the planner makes one attempt with no exclusions.
 _ONE_ATTEMPT = PlanRequest(attempt=1)
 

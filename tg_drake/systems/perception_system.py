@@ -29,7 +29,6 @@ from tg_drake.perception.ground_truth import describe_library_object
 from tg_drake.perception.pipeline import describe_scene
 from tg_drake.types import PerceptionStatus, SceneDescription
 
-
 # How often a new perception_request is looked for [s], and the time of the first look [s]. The
 # offset keeps the looks off the plant's step grid (time steps of 0.1, 0.5, 1, 2, 5, 10 ms): Drake
 # rewrites the state of every system with an update event in a step where any update does
@@ -244,7 +243,7 @@ class GroundTruthPerception(_LatchedPerception):
         self._scene = SceneDescription(objects=[
             describe_library_object(i, _matrix(X), X_WT, spacing=spacing, rng=rng, pose=p,
                                     containment=c)
-            for i, X, p, c in zip(object_ids, X_WO, poses, containments)], X_WT=X_WT)
+            for i, X, p, c in zip(object_ids, X_WO, poses, containments, strict=False)], X_WT=X_WT)
         self._declare_latch()
 
     def _perceive(self, context) -> SceneDescription:

@@ -16,7 +16,7 @@ if TYPE_CHECKING:  # for annotations only: the planner core imports the scenario
     from tg_drake.planning.planner import Plan
 
 
-class PlanState(str, enum.Enum):
+class PlanState(enum.StrEnum):
     """What the planner is doing (``PlanStatus.status``; compares equal to its value)."""
 
     planning = "planning"  # no plan yet, and no failure for the last attempt answered

@@ -28,15 +28,22 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.plant import ContactResults
 from pydrake.systems.framework import EventStatus, LeafSystem
 
-from tg_drake.errors import (GraspingError, KernelError, PerceptionError, PlanningError,
-                             RuleError, SimulationError, TgDrakeError)
-from tg_drake.scenario import SupervisorConfig
+from tg_drake.errors import (
+    GraspingError,
+    KernelError,
+    PerceptionError,
+    PlanningError,
+    RuleError,
+    SimulationError,
+    TgDrakeError,
+)
 from tg_drake.outcome import HandGeometries, hand_contact, placed, touches_table
+from tg_drake.scenario import SupervisorConfig
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 
-class Status(str, enum.Enum):
+class Status(enum.StrEnum):
     """``Outcome.status`` (compares equal to its value)."""
 
     pending = "pending"  # not final yet
@@ -46,7 +53,7 @@ class Status(str, enum.Enum):
     failed = "failed"
 
 
-class Reason(str, enum.Enum):
+class Reason(enum.StrEnum):
     """``Outcome.reason``: why a run failed or fell short of placing ("" when placed)."""
 
     none = ""
@@ -126,7 +133,7 @@ class MonitorModel:
                    tuple(float(v) for v in p_OC))
 
 
-class Phase(str, enum.Enum):
+class Phase(enum.StrEnum):
     gate = "gate"  # the next check runs the gate (at the start, and after a re-query)
     planning = "planning"  # waiting for the planner's answer to the current attempt
     executing = "executing"  # following the plan, monitoring its key times
