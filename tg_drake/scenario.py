@@ -40,7 +40,7 @@ from tg_drake.robot import WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
 from tg_drake.robot_plants import default_directives
 from tg_drake.schema_check import SchemaError, check_document, load_raw
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, table_size_problem
-from tg_drake.types import CONTAINMENTS, PART_LABELS, POSES, TASKS
+from tg_drake.types import CATEGORIES, CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 # The WSG body frame G on the iiwa's link 7 (tg_drake.robot: the mount).
 X_7G = RigidTransform(RollPitchYaw(*X_7G_RPY), X_7G_XYZ)
@@ -457,6 +457,13 @@ def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
     if task.task and task.task not in TASKS:
         raise unknown_name("task", task.task, TASKS, error=ScenarioError, file=where,
                            field="task.task")
+    if task.ground_truth.category and task.ground_truth.category not in CATEGORIES:
+        raise unknown_name("category", task.ground_truth.category, CATEGORIES,
+                           error=ScenarioError, file=where, field="task.ground_truth.category")
+    for part in task.ground_truth.parts:
+        if part not in PART_LABELS:
+            raise unknown_name("part", part, PART_LABELS, error=ScenarioError, file=where,
+                               field="task.ground_truth.parts")
     for t in task.ground_truth.tasks:
         if t not in TASKS:
             raise unknown_name("task", t, TASKS, error=ScenarioError, file=where,

@@ -203,6 +203,10 @@ def test_a_missing_named_entry_lists_the_entries(tmp_path):
     ("task: {place_xy: [0.0, -0.9]}\n", "task.place_xy", "is off the table"),
     ("task: {place_xy: [.nan, 0]}\n", "task.place_xy", "two finite numbers"),
     ("table_size: [0.8, -1]\n", "table_size", "each side at least"),
+    ("task: {ground_truth: {category: mugg}}\n", "task.ground_truth.category",
+     "unknown category 'mugg'; allowed: pan, pot, cup"),
+    ("task: {ground_truth: {parts: [lid]}}\n", "task.ground_truth.parts",
+     "unknown part 'lid'; allowed: top"),
 ])
 def test_simulation_settings_are_checked_before_building(tmp_path, text, field, message):
     with pytest.raises(ScenarioError) as e:
