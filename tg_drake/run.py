@@ -62,6 +62,11 @@ def add_arguments(parser) -> None:
                         "pipeline.logic.category and pipeline.logic.grasp")
 
 
+def default_out(args) -> Path:
+    """The output folder when --out is not given: out/<scenario name>."""
+    return Path("out") / (args.name or args.scenario.stem)
+
+
 def _distribution(d: dict) -> dict:
     return {k: round(float(v), 6) for k, v in sorted(d.items(), key=lambda kv: -kv[1])}
 
@@ -377,7 +382,7 @@ def main(args) -> int:
     scenario = load_scenario(args.scenario, scenario_name=args.name)
     if getattr(args, "theory", None):
         scenario.pipeline.logic.category = scenario.pipeline.logic.grasp = args.theory
-    out = args.out or Path("out") / (args.name or args.scenario.stem)
+    out = args.out or default_out(args)
     out.mkdir(parents=True, exist_ok=True)
     meshcat = None
     if args.meshcat:
