@@ -86,16 +86,12 @@ def read_records(out: Path, cases) -> list[dict]:
     its metadata and "error" (one per setting for a perceived case)."""
     from tg_drake.evaluation.suite import DATASET_OF_SETTING
 
+    from tg_drake.executor import read_records as read_results
+
     by_key = {c.key: c for c in cases}
-    if not out.exists():
-        return []
     lines: dict[str, list[dict]] = {}
-    for line in out.read_text().splitlines():
-        try:
-            r = json.loads(line)
-        except json.JSONDecodeError:
-            continue  # a line cut by a killed run
-        if r.get("job") in by_key:
+    for r in read_results(out):  # a torn last line left out, a malformed file a clear error
+        if r["job"] in by_key:
             lines.setdefault(r["job"], []).append(r)
     records = []
     for key, rs in lines.items():
