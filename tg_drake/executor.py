@@ -139,9 +139,12 @@ class LocalExecutor(Executor):
         suspects: deque[Job] = deque()  # in flight when a worker died: rerun alone
         attempts: dict[str, int] = {}  # job key → times started
 
-        def submit(pool, job):
+        def submit(pool, queue):
+            # A pool broken since the last wait refuses the job: it stays queued, for the next.
+            future = pool.submit(call_job, fn, queue[0].payload)
+            job = queue.popleft()
             attempts[job.key] = attempts.get(job.key, 0) + 1
-            in_flight[pool.submit(call_job, fn, job.payload)] = job
+            in_flight[future] = job
 
         def counted(job, outcome):
             return job, dataclasses.replace(outcome, attempts=attempts[job.key])
@@ -153,9 +156,9 @@ class LocalExecutor(Executor):
                 while pending or suspects or in_flight:
                     # Suspects run one at a time so that the one that kills a worker is known.
                     while not in_flight and suspects:
-                        submit(pool, suspects.popleft())
+                        submit(pool, suspects)
                     while not suspects and pending and len(in_flight) < 2 * self.workers:
-                        submit(pool, pending.popleft())
+                        submit(pool, pending)
                     done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
                     for future in done:
                         outcome = future.result()  # raises BrokenProcessPool if a worker died
@@ -277,6 +280,10 @@ class RayExecutor(Executor):
             job = in_flight.pop(ready)
             try:
                 outcome = ray.get(ready)
+            except ray.exceptions.RayTaskError as e:  # outside call_job: the job could not start
+                cause = getattr(e, "cause", None) or e
+                outcome = Outcome(None, f"the job could not run in a Ray worker: "
+                                        f"{type(cause).__name__}: {_quote(cause)}")
             except ray.exceptions.RayError as e:  # the worker or its node died
                 if attempts[job.key] < RAY_ATTEMPTS:
                     pending.appendleft(job)
