@@ -56,6 +56,7 @@ WORKER_DIED = "worker process died"
 RAY_ATTEMPTS = 3  # times a Ray job is started when its worker or node dies under it
 RAY_CONNECT_TIMEOUT_S = 3.0  # s, for the probe of a Ray cluster's address
 PARENT_POLL_S = 0.5  # s, between a worker's checks that its parent lives (where prctl is missing)
+NO_ANSWER = f"no answer within {RAY_CONNECT_TIMEOUT_S:g} s"
 MAX_QUOTED = 120  # characters of a bad line quoted in an error
 
 
@@ -339,12 +340,59 @@ def check_ray_address(address: str) -> None:
         where, address = f"auto ({resolved})", resolved
     host, port = parse_ray_address(address)
     try:
-        socket.create_connection((host, port), timeout=RAY_CONNECT_TIMEOUT_S).close()
+        if address.startswith("ray://"):  # a Ray Client server: a connection is all we check
+            socket.create_connection((host, port), timeout=RAY_CONNECT_TIMEOUT_S).close()
+            reason = None
+        else:
+            reason = _not_a_gcs(host, port)
     except OSError as e:
-        reason = "no answer" if isinstance(e, TimeoutError) else (e.strerror or str(e))
-        raise TgDrakeError(f"no Ray cluster at --address {where}: {reason} within "
-                           f"{RAY_CONNECT_TIMEOUT_S:g} s (is the cluster up? `ray status` on the "
-                           "head node)") from None
+        reason = NO_ANSWER if isinstance(e, TimeoutError) else (e.strerror or str(e))
+    if reason is not None:
+        raise TgDrakeError(f"no Ray cluster at --address {where}: {reason} (is the cluster up? "
+                           "`ray status` on the head node)") from None
+
+
+def _frame(kind: int, flags: int, stream: int, payload: bytes = b"") -> bytes:
+    """An HTTP/2 frame (RFC 9113, section 4.1)."""
+    return (len(payload).to_bytes(3, "big") + bytes([kind, flags]) + stream.to_bytes(4, "big")
+            + payload)
+
+
+def _not_a_gcs(host: str, port: int) -> str | None:
+    """None if a Ray GCS answers at host:port, else why not. Sends the GCS one gRPC call
+    (GetClusterId, an empty request) over plain HTTP/2 and reads the status of its response: a
+    GCS answers 200; a proxy or another server that accepts any connection answers otherwise."""
+
+    def literal(name_index: int, value: str) -> bytes:  # HPACK, without indexing, no Huffman
+        return bytes([name_index, len(value)]) + value.encode()
+
+    headers = (b"\x83\x86"  # :method POST, :scheme http (HPACK static table)
+               + literal(0x04, "/ray.rpc.NodeInfoGcsService/GetClusterId")  # :path
+               + literal(0x01, f"{host}:{port}")  # :authority
+               + b"\x0f\x10" + literal(0x10, "application/grpc")[1:]  # content-type
+               + b"\x00" + literal(2, "te")[1:] + literal(8, "trailers")[1:])
+    with socket.create_connection((host, port), timeout=RAY_CONNECT_TIMEOUT_S) as s:
+        s.settimeout(RAY_CONNECT_TIMEOUT_S)
+        s.sendall(b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n" + _frame(4, 0, 0)  # preface, SETTINGS
+                  + _frame(1, 4, 1, headers)  # HEADERS, END_HEADERS
+                  + _frame(0, 1, 1, bytes(5)))  # DATA, END_STREAM: an empty gRPC message
+        deadline = time.monotonic() + RAY_CONNECT_TIMEOUT_S
+        data = b""
+        while time.monotonic() < deadline:
+            while len(data) >= 9 and len(data) >= 9 + int.from_bytes(data[:3], "big"):
+                n, kind, flags = int.from_bytes(data[:3], "big"), data[3], data[4]
+                payload, data = data[9:9 + n], data[9 + n:]
+                if kind == 4 and not flags & 1:  # the server's SETTINGS: acknowledge them
+                    s.sendall(_frame(4, 1, 0))
+                elif kind == 1:  # the response's HEADERS: ":status: 200" is 0x88 in HPACK
+                    return None if payload[:1] == b"\x88" else "it answers, but not as a Ray GCS"
+                elif kind in (3, 7):  # RST_STREAM, GOAWAY
+                    return "it refused a Ray GCS request"
+            chunk = s.recv(4096)
+            if not chunk:
+                return "it closed the connection (not a Ray GCS)"
+            data += chunk
+    return NO_ANSWER
 
 
 def make_executor(kind: str = "local", *, workers: int | None = None,

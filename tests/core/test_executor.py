@@ -272,6 +272,41 @@ def test_an_unreachable_ray_address_is_a_clear_error(monkeypatch):
 
 
 @ray_installed
+@pytest.mark.parametrize("server, reason", [
+    ("close", "(it closed the connection .not a Ray GCS.|Connection reset by peer)"),
+    ("http1", "(it closed the connection .not a Ray GCS.|Connection reset by peer)"),
+    ("silent", "no answer within 3 s"),
+])
+def test_an_address_where_something_else_answers_is_a_clear_error(server, reason):
+    """A proxy or another server that accepts any connection is not taken for a cluster."""
+    import threading
+
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen()
+    port = listener.getsockname()[1]
+
+    def serve():
+        connection, _ = listener.accept()
+        if server == "http1":
+            connection.recv(1024)
+            connection.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n")
+        if server != "silent":
+            connection.close()
+        else:
+            time.sleep(5)  # s: longer than the probe waits
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        with pytest.raises(TgDrakeError, match=f"^no Ray cluster at --address 127.0.0.1:{port}: "
+                                               f"{reason}"):
+            make_executor("ray", address=f"127.0.0.1:{port}")
+    finally:
+        listener.close()
+
+
+@ray_installed
 def test_address_auto_with_no_cluster_or_a_stale_one_is_a_clear_error(tmp_path, monkeypatch):
     import ray._private.services as services
 

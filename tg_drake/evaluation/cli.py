@@ -85,7 +85,6 @@ def read_records(out: Path, cases) -> list[dict]:
     """The records of `cases` in results.jsonl; a case recorded as an error becomes a record with
     its metadata and "error" (one per setting for a perceived case)."""
     from tg_drake.evaluation.suite import DATASET_OF_SETTING
-
     from tg_drake.executor import read_records as read_results
 
     by_key = {c.key: c for c in cases}
