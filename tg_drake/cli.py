@@ -25,6 +25,15 @@ COMMANDS: dict[str, str] = {
     "eval": "tg_drake.evaluation.cli",
 }
 
+# command → its options that name a path it writes, and whether each is a "folder" or a "file".
+# Checked before the command starts, so a bad path is answered before any work.
+OUTPUTS: dict[str, dict[str, str]] = {
+    "bench": {"out": "file"},
+    "render": {"out": "folder"},
+    "run": {"out": "folder"},
+    "eval": {"out": "folder", "tables": "folder"},
+}
+
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
@@ -38,9 +47,31 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+def check_outputs(args) -> None:
+    """Checks every output path of the command, before it runs (tg_drake.outputs).
+
+    A command whose output folder has a default computed from its other arguments gives it with
+    `default_out(args)`.
+    """
+    from tg_drake.outputs import check_output_dir, check_output_file
+
+    for option, kind in OUTPUTS.get(args.command, {}).items():
+        path = getattr(args, option)
+        if path is None and option == "out" and hasattr(args._module, "default_out"):
+            path = args._module.default_out(args)
+        if path is None:
+            continue
+        what = f"--{option} {kind}"
+        if kind == "file":
+            check_output_file(path, what=what)
+        else:
+            check_output_dir(path, what=what)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
+        check_outputs(args)
         return int(args._module.main(args) or 0)
     except TgDrakeError as e:
         print(f"tg-drake {args.command}: error: {e}", file=sys.stderr)

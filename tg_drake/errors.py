@@ -60,6 +60,11 @@ class SimulationError(TgDrakeError):
     """The physics simulation failed (diverged, NaN state, solver failure)."""
 
 
+class OutputError(TgDrakeError, ValueError):
+    """An output path cannot be written (a file where a folder is needed, no permission, a
+    read-only or virtual file system), or a results file to resume from is malformed."""
+
+
 def unknown_name(kind: str, name: object, allowed, *, error: type[TgDrakeError], **where):
     """Builds the error for an unknown name, listing the allowed values (manipulation's style).
 

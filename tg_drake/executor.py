@@ -8,22 +8,36 @@ One interface for every sweep (grasp-data collection, scenario evaluation):
 - A `Job` has a stable `key` and a picklable `payload`; `fn(payload)` returns one JSON-serialisable
   dict or a list of them (a job may be a batch). Every record is written as one line with the
   job's key under "job", as soon as its job finishes, and flushed.
-- A rerun reads the file first and skips every job that already has a line.
+- A rerun reads the file first and skips every job that already has a line. A torn last line (a
+  run killed mid-write) is cut off the file; any other line that is not a record (a JSON object
+  with a "job" key) is an error naming the file and the line, as is a file that is not UTF-8.
 - A job that raises is recorded as {"job": key, "status": "error", "reason": "..."}; one that kills
   its worker process (a segfault, an abort in native code) is found by rerunning the jobs that were
   in flight one at a time, and is recorded with the reason "worker process died". Neither stops
-  the sweep.
+  the sweep. The records of a job that ran more than once (its worker died under it) carry
+  "attempts": the number of times it was started.
 
-`LocalExecutor` is a process pool (spawned workers; `workers=0` runs in this process, for
-debugging). `RayExecutor` submits to a Ray cluster; Ray is an optional dependency
-(`pip install 'tg_drake[ray]'`) and is imported only when that executor is made.
+`LocalExecutor` is a process pool (spawned workers, which die with the process that started them;
+`workers=0` runs in this process, for debugging). `RayExecutor` submits to a Ray cluster, or
+starts a local Ray instance of its own (its own temp folder); an address is checked (its form, then
+a connection) before Ray is started. Ray is an optional dependency (`pip install 'tg_drake[ray]'`)
+and is imported only when that executor is made.
 """
 
 from __future__ import annotations
 
+import ctypes
+import dataclasses
 import json
 import multiprocessing
 import os
+import shutil
+import signal
+import socket
+import sys
+import tempfile
+import threading
+import time
 import traceback
 from abc import ABC, abstractmethod
 from collections import deque
@@ -34,10 +48,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tg_drake.errors import TgDrakeError, unknown_name
+from tg_drake.errors import OutputError, TgDrakeError, unknown_name
+from tg_drake.outputs import check_output_file
 
 EXECUTORS = ("local", "ray")
 WORKER_DIED = "worker process died"
+RAY_ATTEMPTS = 3  # times a Ray job is started when its worker or node dies under it
+RAY_CONNECT_TIMEOUT_S = 3.0  # s, for the probe of a Ray cluster's address
+PARENT_POLL_S = 0.5  # s, between a worker's checks that its parent lives (where prctl is missing)
+NO_ANSWER = f"no answer within {RAY_CONNECT_TIMEOUT_S:g} s"
+MAX_QUOTED = 120  # characters of a bad line quoted in an error
 
 
 @dataclass(frozen=True)
@@ -54,6 +74,7 @@ class Outcome:
 
     records: list[dict] | None
     error: str | None = None
+    attempts: int = 1  # times the job was started (> 1: its worker died under an earlier one)
 
 
 @dataclass
@@ -93,14 +114,22 @@ class LocalExecutor(Executor):
 
     def __init__(self, workers: int | None = None, *, max_tasks_per_child: int | None = None):
         workers = (os.cpu_count() or 1) if workers is None else workers
-        if workers < 0:
-            raise TgDrakeError(f"workers must be ≥ 0, got {workers}")
+        if not isinstance(workers, int) or workers < 0:
+            raise TgDrakeError(f"workers (--workers) must be a number of processes ≥ 1, or 0 to "
+                               f"run the jobs in this process (for debugging); got {workers!r}")
         self.workers = workers
         self.max_tasks_per_child = max_tasks_per_child  # recycle workers that leak memory
 
     def _pool(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
-                                   max_tasks_per_child=self.max_tasks_per_child)
+        pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
+                                   max_tasks_per_child=self.max_tasks_per_child,
+                                   initializer=die_with_parent, initargs=(os.getpid(),))
+        # Start every worker with the pool: one spawned on demand, as the pool's watcher thread
+        # has begun to wait, is not watched, and its death (a job that kills it while the other
+        # jobs run on) would leave the sweep waiting forever.
+        if hasattr(pool, "_safe_to_dynamically_spawn_children"):
+            pool._safe_to_dynamically_spawn_children = False
+        return pool
 
     def imap_unordered(self, fn, jobs):
         if self.workers == 0:
@@ -109,6 +138,18 @@ class LocalExecutor(Executor):
             return
         pending = deque(jobs)
         suspects: deque[Job] = deque()  # in flight when a worker died: rerun alone
+        attempts: dict[str, int] = {}  # job key → times started
+
+        def submit(pool, queue):
+            # A pool broken since the last wait refuses the job: it stays queued, for the next.
+            future = pool.submit(call_job, fn, queue[0].payload)
+            job = queue.popleft()
+            attempts[job.key] = attempts.get(job.key, 0) + 1
+            in_flight[future] = job
+
+        def counted(job, outcome):
+            return job, dataclasses.replace(outcome, attempts=attempts[job.key])
+
         while pending or suspects:
             pool = self._pool()
             in_flight: dict = {}
@@ -116,32 +157,60 @@ class LocalExecutor(Executor):
                 while pending or suspects or in_flight:
                     # Suspects run one at a time so that the one that kills a worker is known.
                     while not in_flight and suspects:
-                        job = suspects.popleft()
-                        in_flight[pool.submit(call_job, fn, job.payload)] = job
+                        submit(pool, suspects)
                     while not suspects and pending and len(in_flight) < 2 * self.workers:
-                        job = pending.popleft()
-                        in_flight[pool.submit(call_job, fn, job.payload)] = job
+                        submit(pool, pending)
                     done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
                     for future in done:
                         outcome = future.result()  # raises BrokenProcessPool if a worker died
-                        yield in_flight.pop(future), outcome
+                        yield counted(in_flight.pop(future), outcome)
             except BrokenProcessPool:
                 # Futures that finished before the pool broke keep their results.
                 for future, job in list(in_flight.items()):
                     if future.done() and not future.cancelled() and future.exception() is None:
                         del in_flight[future]
-                        yield job, future.result()
+                        yield counted(job, future.result())
                 if len(in_flight) == 1:
                     (job,) = in_flight.values()
-                    yield job, Outcome(None, WORKER_DIED)
+                    yield counted(job, Outcome(None, WORKER_DIED))
                 else:
                     suspects.extend(in_flight.values())
             finally:
                 pool.shutdown(wait=True, cancel_futures=True)
 
 
+def die_with_parent(parent_pid: int) -> None:
+    """A worker's initializer: the worker is killed when the process that started it dies (a
+    killed sweep leaves no workers behind). On Linux the kernel does it (prctl PR_SET_PDEATHSIG),
+    even while the worker runs native code; elsewhere a thread polls the parent's pid."""
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            pr_set_pdeathsig = 1  # from <linux/prctl.h>
+            if libc.prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0) == 0:
+                if os.getppid() != parent_pid:  # the parent died before the call
+                    os._exit(1)
+                return
+        except (OSError, AttributeError):
+            pass
+
+    def watch():
+        while os.getppid() == parent_pid:
+            time.sleep(PARENT_POLL_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="die-with-parent", daemon=True).start()
+
+
 class RayExecutor(Executor):
-    """Jobs as Ray tasks on a cluster (`address`, e.g. "auto") or a local Ray instance (None)."""
+    """Jobs as Ray tasks on a cluster (`address`: host:port, ray://host:port or "auto") or on a
+    local Ray instance started for the sweep (None or "local"; None means RAY_ADDRESS if it is
+    set), in a temp folder
+    of its own and shut down when the jobs are done.
+
+    The address is checked when the executor is made: its form, then that something answers there
+    (within RAY_CONNECT_TIMEOUT_S), so a wrong one is a clear error before any work.
+    """
 
     def __init__(self, address: str | None = None, *, max_in_flight: int | None = None):
         try:
@@ -150,29 +219,180 @@ class RayExecutor(Executor):
             raise TgDrakeError(
                 "the Ray executor needs Ray, which is not installed: "
                 "pip install 'tg_drake[ray]'") from None
+        if max_in_flight is not None and (not isinstance(max_in_flight, int)
+                                          or max_in_flight < 1):
+            raise TgDrakeError(f"workers (--workers) with the ray executor is the number of jobs "
+                               f"in flight, ≥ 1; got {max_in_flight!r}")
         self._ray = ray
+        if address is None and os.environ.get("RAY_ADDRESS"):
+            address = os.environ["RAY_ADDRESS"]
+        address = None if address == "local" else address
         self.address = address
+        if address is not None and not ray.is_initialized():
+            check_ray_address(address)
         self.max_in_flight = max_in_flight or 1000  # tasks submitted and not yet finished
+
+    def _init(self) -> str | None:
+        """Connects to the cluster or starts a local instance; the temp folder to remove after
+        shutdown (a local instance's), or None."""
+        ray = self._ray
+        if self.address is not None:
+            try:
+                ray.init(address=self.address)
+            except (ConnectionError, RuntimeError, ValueError, TimeoutError) as e:
+                raise TgDrakeError(f"cannot connect to the Ray cluster at {self.address!r}: "
+                                   f"{_quote(e)}") from None
+            return None
+        # A local instance of its own: a stale shared /tmp/ray (a crashed earlier instance) is
+        # neither joined nor reused. The folder is short: Ray's sockets live under it, and a Unix
+        # socket's path has at most 107 bytes.
+        base = tempfile.gettempdir()
+        temp_dir = tempfile.mkdtemp(prefix="tg-ray-", dir=base if len(base) <= 20 else "/tmp")
+        ray.init(address="local", _temp_dir=temp_dir)
+        return temp_dir
 
     def imap_unordered(self, fn, jobs):
         ray = self._ray
+        started, temp_dir = False, None
         if not ray.is_initialized():
-            ray.init(address=self.address)
-        remote = ray.remote(call_job)
+            temp_dir = self._init()
+            started = True
+        try:
+            yield from self._imap(fn, jobs)
+        finally:
+            if started:
+                ray.shutdown()
+            if temp_dir is not None:
+                shutil.rmtree(temp_dir, ignore_errors=True)
+
+    def _imap(self, fn, jobs):
+        ray = self._ray
+        remote = ray.remote(max_retries=0)(call_job)  # retried here, and counted
         fn_ref = ray.put(fn)
         pending = deque(jobs)
         in_flight: dict = {}
+        attempts: dict[str, int] = {}
         while pending or in_flight:
             while pending and len(in_flight) < self.max_in_flight:
                 job = pending.popleft()
+                attempts[job.key] = attempts.get(job.key, 0) + 1
                 in_flight[remote.remote(fn_ref, job.payload)] = job
             (ready,), _ = ray.wait(list(in_flight), num_returns=1)
             job = in_flight.pop(ready)
             try:
                 outcome = ray.get(ready)
+            except ray.exceptions.RayTaskError as e:  # outside call_job: the job could not start
+                cause = getattr(e, "cause", None) or e
+                outcome = Outcome(None, f"the job could not run in a Ray worker: "
+                                        f"{type(cause).__name__}: {_quote(cause)}")
             except ray.exceptions.RayError as e:  # the worker or its node died
+                if attempts[job.key] < RAY_ATTEMPTS:
+                    pending.appendleft(job)
+                    continue
                 outcome = Outcome(None, f"{WORKER_DIED}: {type(e).__name__}")
-            yield job, outcome
+            yield job, dataclasses.replace(outcome, attempts=attempts[job.key])
+
+
+def _quote(value: object) -> str:
+    text = " ".join(str(value).split())
+    return text if len(text) <= MAX_QUOTED else text[:MAX_QUOTED] + "…"
+
+
+def parse_ray_address(address: str) -> tuple[str, int]:
+    """(host, port) of a Ray address "host:port" or "ray://host:port" ("[::1]:6379" for IPv6);
+    a TgDrakeError for anything else."""
+    bad = TgDrakeError(f"malformed Ray address {_quote(address)!r}: expected host:port (e.g. "
+                       "127.0.0.1:6379, the head node's GCS port), ray://host:port (Ray Client) "
+                       "or auto (the cluster started on this machine with `ray start --head`)")
+    rest = address.removeprefix("ray://")
+    host, sep, port = rest.rpartition(":")
+    if host.startswith("[") and host.endswith("]"):
+        host = host[1:-1]
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536 \
+            or any(c in host for c in "/ @?#[]"):
+        raise bad
+    return host, int(port)
+
+
+def resolve_ray_auto() -> str:
+    """The address `ray.init(address="auto")` would connect to, found as Ray finds it
+    (RAY_ADDRESS, the last cluster `ray start` recorded, a GCS process on this machine)."""
+    try:
+        from ray._private.services import canonicalize_bootstrap_address
+    except ImportError:  # Ray moved its private helper: let ray.init resolve "auto" itself
+        return "auto"
+    try:
+        found = canonicalize_bootstrap_address("auto")
+    except (ConnectionError, ValueError) as e:
+        raise TgDrakeError(f"--address auto: no Ray cluster found on this machine ({_quote(e)}); "
+                           "start one with `ray start --head`, give its host:port, or leave "
+                           "--address out to start a local Ray instance") from None
+    return found or "auto"
+
+
+def check_ray_address(address: str) -> None:
+    """Raises a TgDrakeError unless `address` is well formed and something answers there."""
+    where = address
+    if address == "auto":
+        resolved = resolve_ray_auto()
+        if resolved == "auto":
+            return
+        where, address = f"auto ({resolved})", resolved
+    host, port = parse_ray_address(address)
+    try:
+        if address.startswith("ray://"):  # a Ray Client server: a connection is all we check
+            socket.create_connection((host, port), timeout=RAY_CONNECT_TIMEOUT_S).close()
+            reason = None
+        else:
+            reason = _not_a_gcs(host, port)
+    except OSError as e:
+        reason = NO_ANSWER if isinstance(e, TimeoutError) else (e.strerror or str(e))
+    if reason is not None:
+        raise TgDrakeError(f"no Ray cluster at --address {where}: {reason} (is the cluster up? "
+                           "`ray status` on the head node)") from None
+
+
+def _frame(kind: int, flags: int, stream: int, payload: bytes = b"") -> bytes:
+    """An HTTP/2 frame (RFC 9113, section 4.1)."""
+    return (len(payload).to_bytes(3, "big") + bytes([kind, flags]) + stream.to_bytes(4, "big")
+            + payload)
+
+
+def _not_a_gcs(host: str, port: int) -> str | None:
+    """None if a Ray GCS answers at host:port, else why not. Sends the GCS one gRPC call
+    (GetClusterId, an empty request) over plain HTTP/2 and reads the status of its response: a
+    GCS answers 200; a proxy or another server that accepts any connection answers otherwise."""
+
+    def literal(name_index: int, value: str) -> bytes:  # HPACK, without indexing, no Huffman
+        return bytes([name_index, len(value)]) + value.encode()
+
+    headers = (b"\x83\x86"  # :method POST, :scheme http (HPACK static table)
+               + literal(0x04, "/ray.rpc.NodeInfoGcsService/GetClusterId")  # :path
+               + literal(0x01, f"{host}:{port}")  # :authority
+               + b"\x0f\x10" + literal(0x10, "application/grpc")[1:]  # content-type
+               + b"\x00" + literal(2, "te")[1:] + literal(8, "trailers")[1:])
+    with socket.create_connection((host, port), timeout=RAY_CONNECT_TIMEOUT_S) as s:
+        s.settimeout(RAY_CONNECT_TIMEOUT_S)
+        s.sendall(b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n" + _frame(4, 0, 0)  # preface, SETTINGS
+                  + _frame(1, 4, 1, headers)  # HEADERS, END_HEADERS
+                  + _frame(0, 1, 1, bytes(5)))  # DATA, END_STREAM: an empty gRPC message
+        deadline = time.monotonic() + RAY_CONNECT_TIMEOUT_S
+        data = b""
+        while time.monotonic() < deadline:
+            while len(data) >= 9 and len(data) >= 9 + int.from_bytes(data[:3], "big"):
+                n, kind, flags = int.from_bytes(data[:3], "big"), data[3], data[4]
+                payload, data = data[9:9 + n], data[9 + n:]
+                if kind == 4 and not flags & 1:  # the server's SETTINGS: acknowledge them
+                    s.sendall(_frame(4, 1, 0))
+                elif kind == 1:  # the response's HEADERS: ":status: 200" is 0x88 in HPACK
+                    return None if payload[:1] == b"\x88" else "it answers, but not as a Ray GCS"
+                elif kind in (3, 7):  # RST_STREAM, GOAWAY
+                    return "it refused a Ray GCS request"
+            chunk = s.recv(4096)
+            if not chunk:
+                return "it closed the connection (not a Ray GCS)"
+            data += chunk
+    return NO_ANSWER
 
 
 def make_executor(kind: str = "local", *, workers: int | None = None,
@@ -188,22 +408,58 @@ def make_executor(kind: str = "local", *, workers: int | None = None,
     raise unknown_name("executor", kind, EXECUTORS, error=TgDrakeError)
 
 
+def read_records(out: Path) -> list[dict]:
+    """Every record in the results file `out` ([] if there is none). A torn last line (no newline
+    at its end, not JSON: a run killed mid-write) is left out; any other line that is not a JSON
+    object with a "job" key, a folder in place of the file, or a file that is not UTF-8 is an
+    OutputError naming the file and the line."""
+    return _read(out)[0]
+
+
+def _read(out: Path) -> tuple[list[dict], int | None]:
+    """The records of `out`, and the offset where a torn last line starts (None if none)."""
+    if out.is_dir():
+        raise OutputError("the results file is a folder", file=str(out))
+    try:
+        data = out.read_bytes()
+    except FileNotFoundError:
+        return [], None
+    except OSError as e:
+        raise OutputError(f"the results file cannot be read: {e.strerror}", file=str(out)) from None
+    records, offset, torn = [], 0, None
+    for number, line in enumerate(data.splitlines(keepends=True), start=1):
+        start, offset = offset, offset + len(line)
+        last = offset == len(data) and not line.endswith(b"\n")
+        try:
+            text = line.decode("utf-8")
+        except UnicodeDecodeError as e:
+            if last:
+                torn = start
+                break
+            raise OutputError(f"not UTF-8 text (byte {e.start + 1} of the line): not a results "
+                              "file of a sweep?", file=str(out), line=number) from None
+        text = text.rstrip("\r\n")
+        if not text.strip():
+            continue
+        try:
+            record = json.loads(text)
+        except json.JSONDecodeError as e:
+            if last:
+                torn = start
+                break
+            raise OutputError(f"not a JSON record ({e.msg}): {_quote(text)!r}; remove the line or "
+                              "choose another output", file=str(out), line=number) from None
+        if not isinstance(record, dict) or not isinstance(record.get("job"), str):
+            raise OutputError('not a record of a sweep (expected a JSON object with a "job" '
+                              f"string): {_quote(text)!r}", file=str(out), line=number)
+        records.append(record)
+    return records, torn
+
+
 def finished_jobs(out: Path, *, retry_errors: bool = False) -> set[str]:
-    """Keys of the jobs that already have a line in `out` (a torn last line is ignored)."""
-    done: set[str] = set()
-    if not out.exists():
-        return done
-    with out.open() as f:
-        for line in f:
-            try:
-                record = json.loads(line)
-            except json.JSONDecodeError:
-                continue  # the last line of a run that was killed mid-write
-            if retry_errors and record.get("status") == "error":
-                continue
-            if "job" in record:
-                done.add(record["job"])
-    return done
+    """Keys of the jobs that already have a record in `out` (read_records)."""
+    return {r["job"] for r in read_records(out)
+            if not (retry_errors and r.get("status") == "error")}
 
 
 def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, executor: Executor,
@@ -216,9 +472,14 @@ def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, execut
     keys = [job.key for job in jobs]
     if len(set(keys)) != len(keys):
         raise TgDrakeError("job keys must be unique")
-    done = finished_jobs(out, retry_errors=retry_errors)
+    check_output_file(out, what="results file")
+    records, torn = _read(out)
+    done = {r["job"] for r in records if not (retry_errors and r.get("status") == "error")}
     todo = [job for job in jobs if job.key not in done]
     out.parent.mkdir(parents=True, exist_ok=True)
+    if torn is not None:  # the last line of a run killed mid-write: cut it off
+        with out.open("r+b") as f:
+            f.truncate(torn)
     summary = RunSummary(len(jobs), len(jobs) - len(todo), 0, 0, 0)
     bar = None
     if progress:
@@ -226,7 +487,7 @@ def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, execut
 
         bar = tqdm(total=len(todo), desc=out.name, unit="job")
     with out.open("a") as f:
-        # A file cut mid-line by a killed run: start on a fresh line.
+        # A last record without its newline (an edited file): start on a fresh line.
         if f.tell() > 0:
             with out.open("rb") as r:
                 r.seek(-1, os.SEEK_END)
@@ -238,6 +499,8 @@ def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, execut
                 summary.n_errors += 1
             else:
                 records = outcome.records
+            if outcome.attempts > 1:
+                records = [{**r, "attempts": outcome.attempts} for r in records]
             # One write per job: its lines land together.
             f.write("".join(json.dumps({"job": job.key, **r}) + "\n" for r in records))
             f.flush()

@@ -47,6 +47,11 @@ def add_arguments(parser) -> None:
                         "pipeline.logic.category and pipeline.logic.grasp")
 
 
+def default_out(args) -> Path:
+    """The output folder when --out is not given: out/<scenario name>."""
+    return Path("out") / (args.name or args.scenario.stem)
+
+
 def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
         ) -> tuple[dict, object]:
     """Runs one scenario end to end: the result dictionary (result.json) and what the pictures
@@ -137,7 +142,7 @@ def main(args) -> int:
     scenario = load_scenario(args.scenario, scenario_name=args.name)
     if getattr(args, "theory", None):
         scenario.pipeline.logic.category = scenario.pipeline.logic.grasp = args.theory
-    out = args.out or Path("out") / (args.name or args.scenario.stem)
+    out = args.out or default_out(args)
     meshcat = None
     if args.meshcat:
         from pydrake.geometry import StartMeshcat

@@ -27,9 +27,11 @@ from pathlib import Path
 
 import numpy as np
 
-from tg_drake.executor import EXECUTORS, Job, finished_jobs, make_executor, run_jobs
+from tg_drake.errors import TgDrakeError
+from tg_drake.executor import EXECUTORS, Job, finished_jobs, make_executor, read_records, run_jobs
 from tg_drake.grasping.dataset import SamplingConfig, library_scenes, scene_grasps
 from tg_drake.objects import get_object, load_library
+from tg_drake.outputs import check_output_file
 from tg_drake.simulation.episode import EpisodeConfig, run_grasp_batch
 
 
@@ -53,15 +55,7 @@ def make_jobs(objects, *, seed: int, batch: int, sampling: SamplingConfig,
 
 def recorded_masses(out: Path) -> set[float]:
     """The --object-mass values (0.0: the objects' own) the grasps already in `out` ran with."""
-    if not out.exists():
-        return set()
-    masses = set()
-    for line in out.read_text().splitlines():
-        try:
-            masses.add(float(json.loads(line).get("object_mass", 0.0)))
-        except (json.JSONDecodeError, AttributeError):
-            continue  # a torn last line
-    return masses
+    return {float(r.get("object_mass", 0.0)) for r in read_records(out)}
 
 
 def summarise(records: list[dict], *, seed: int, through_table: int) -> dict:
@@ -98,6 +92,14 @@ def summarise(records: list[dict], *, seed: int, through_table: int) -> dict:
 
 
 def main(argv=None) -> int:
+    try:
+        return collect(argv)
+    except TgDrakeError as e:  # a bad --out, results file or executor option
+        print(f"collect_grasps.py: error: {e}", file=sys.stderr)
+        return 2
+
+
+def collect(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path, default=Path("data/dgi/grasps.jsonl"))
     parser.add_argument("--objects", help="comma-separated object ids (default: the library)")
@@ -119,6 +121,7 @@ def main(argv=None) -> int:
     if args.object_mass < 0:
         parser.error(f"--object-mass must be ≥ 0 kg, got {args.object_mass}")
     episode = EpisodeConfig(object_mass=args.object_mass)
+    check_output_file(args.out, what="--out file")
     mixed = recorded_masses(args.out) - {args.object_mass}
     if mixed:  # a rerun skips the finished jobs: their labels would be of another mass
         parser.error(f"{args.out} holds grasps executed with --object-mass "
@@ -137,8 +140,7 @@ def main(argv=None) -> int:
     wall = time.perf_counter() - start
 
     keys = {j.key for j in jobs}
-    records = [json.loads(line) for line in args.out.read_text().splitlines() if line.strip()]
-    records = [r for r in records if r["job"] in keys]
+    records = [r for r in read_records(args.out) if r["job"] in keys]
     summary = summarise(records, seed=args.seed, through_table=through_table)
     summary["object_mass_kg"] = args.object_mass or None  # None: every object at its own mass
     ran = sum(len(j.payload["grasps"]) for j in jobs if j.key not in done)

@@ -5,6 +5,7 @@ sweep runs on a local Ray instance."""
 import json
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -128,3 +129,41 @@ def test_another_theory_variant_runs_under_its_own_keys(tmp_path, capsys):
         "tiny/hammer_01_sideways_empty#learned"}
     assert {r["theory"] for r in records} == {"learned"}
     assert all("category" in r["methods"]["plm"] for r in records)
+
+
+def test_a_malformed_results_file_or_path_is_a_clear_error(tmp_path, capsys):
+    results = tmp_path / "results.jsonl"
+    results.mkdir()
+    assert eval_(TINY, "--out", tmp_path, "--workers", "0") == 2
+    assert f"tg-drake eval: error: {results}: the results file is a folder" in \
+        capsys.readouterr().err
+    results.rmdir()
+    results.write_text('{"job": "tiny/cup_01_upright_empty"}\n{"status": "ok"}\n')
+    for extra in ([], ["--tables-only"]):
+        assert eval_(TINY, "--out", tmp_path, "--workers", "0", *extra) == 2
+        assert f"tg-drake eval: error: {results}:2: not a record of a sweep" in \
+            capsys.readouterr().err
+    results.write_bytes(b"\xff\xfe\n")
+    assert eval_(TINY, "--out", tmp_path, "--tables-only") == 2
+    assert f"{results}:1: not UTF-8 text" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("options, message", [
+    (["--workers", "-1"], "must be a number of processes ≥ 1, or 0 to run the jobs in this"),
+    (["--executor", "ray", "--workers", "0"], "the number of jobs in flight, ≥ 1"),
+    (["--executor", "ray", "--address", "head-node"], "malformed Ray address 'head-node'"),
+    (["--executor", "ray", "--address", "127.0.0.1:{port}"],
+     "no Ray cluster at --address 127.0.0.1:{port}: Connection refused"),
+])
+def test_bad_executor_options_are_refused_before_any_work(options, message, tmp_path, capsys,
+                                                          monkeypatch):
+    if "ray" in options:
+        pytest.importorskip("ray")
+    monkeypatch.delenv("RAY_ADDRESS", raising=False)
+    with socket.socket() as s:  # a port where nothing listens
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    options = [o.format(port=port) for o in options]
+    assert eval_(TINY, "--out", tmp_path, *options) == 2
+    assert message.format(port=port) in capsys.readouterr().err
+    assert not (tmp_path / "results.jsonl").exists()

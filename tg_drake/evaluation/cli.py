@@ -22,6 +22,7 @@ from pathlib import Path
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
+from tg_drake.executor import read_records as read_results
 from tg_drake.types import THEORY_VARIANTS as VARIANTS
 
 # Start-up: `tg-drake --help` imports this module, so the suite, scenario, table and job modules
@@ -95,15 +96,9 @@ def read_records(out: Path, cases) -> list[dict]:
     from tg_drake.evaluation.suite import DATASET_OF_SETTING  # start-up (pydrake)
 
     by_key = {c.key: c for c in cases}
-    if not out.exists():
-        return []
     lines: dict[str, list[dict]] = {}
-    for line in out.read_text().splitlines():
-        try:
-            r = json.loads(line)
-        except json.JSONDecodeError:
-            continue  # a line cut by a killed run
-        if r.get("job") in by_key:
+    for r in read_results(out):  # a torn last line left out, a malformed file a clear error
+        if r["job"] in by_key:
             lines.setdefault(r["job"], []).append(r)
     records = []
     for key, rs in lines.items():

@@ -393,6 +393,10 @@ def _scenes(suite: Suite, where: str) -> list[Case]:
                               task=variation.task or scene.task.task,
                               place_xy=list(scene.task.place_xy),
                               ground_truth=scene.task.ground_truth)
+            for part in list(variation.parts) + list(scene.task.ground_truth.parts):
+                if part not in PART_LABELS:  # named by the suite's field, before the scenario's
+                    raise unknown_name("part", part, PART_LABELS, error=ScenarioError,
+                                       file=where, field=f + ".task.ground_truth.parts")
             scenario = Scenario(objects=objects, task=task)
             try:
                 validate(scenario, where=where)
@@ -403,10 +407,6 @@ def _scenes(suite: Suite, where: str) -> list[Case]:
             gt = task.ground_truth
             category = gt.category or get_object(target.id).category
             parts = list(variation.parts) if variation.task else list(gt.parts)
-            for part in parts:
-                if part not in PART_LABELS:
-                    raise unknown_name("part", part, PART_LABELS, error=ScenarioError,
-                                       file=where, field=f + ".task.ground_truth.parts")
             if not gt.reason:
                 raise ScenarioError("a scene's ground truth needs its `reason`", file=where,
                                     field=f + ".task.ground_truth.reason")
