@@ -28,6 +28,7 @@ checked after every re-query) and judges the execution: simulate until
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -105,8 +106,14 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
         if camera not in station.cameras:
             raise unknown_name("camera", camera, list(station.cameras),
                                error=ScenarioError, field="pipeline.perception.camera")
+        # The scenario's random_seed seeds perception's RANSAC too (added to the config's seed,
+        # so that both settings are honoured; both 0 by default).
+        perception_config = config.perception.config
+        perception_config = dataclasses.replace(perception_config, segmentation=dataclasses.replace(
+            perception_config.segmentation,
+            seed=perception_config.segmentation.seed + scenario.random_seed))
         perception = builder.AddNamedSystem("perception", PerceptionSystem(
-            camera_info=station.cameras[camera].info, config=config.perception.config))
+            camera_info=station.cameras[camera].info, config=perception_config))
         builder.Connect(station.outputs[f"{camera}.depth_image"],
                         perception.GetInputPort("depth_image"))
         builder.Connect(station.outputs[f"{camera}.camera_pose"],

@@ -249,3 +249,14 @@ def test_a_long_value_is_quoted_short(tmp_path):
     with pytest.raises(ScenarioError) as e:
         _load(tmp_path, "simulation_duration: [" + ", ".join(["1"] * 5000) + "]\n")
     assert len(str(e.value)) < 400
+
+
+def test_random_seed_seeds_the_perception_stage(tmp_path):
+    from pydrake.systems.framework import DiagramBuilder
+
+    from tg_drake.diagram import add_pipeline
+
+    scenario = _load(tmp_path, "random_seed: 7\npipeline:\n  perception: !DepthPerception\n"
+                     "    config: {segmentation: {seed: 2}}\n")
+    pipeline = add_pipeline(DiagramBuilder(), scenario=scenario)
+    assert pipeline.perception.config.segmentation.seed == 9  # the config's seed + random_seed

@@ -194,6 +194,11 @@ class PerceptionSystem(_LatchedPerception):
     def intrinsics(self) -> Intrinsics:
         return self._intrinsics
 
+    @property
+    def config(self) -> PerceptionConfig:
+        """The perception parameters this system runs with."""
+        return self._config
+
     def get_depth_image_input_port(self):
         return self._depth_port
 
