@@ -14,6 +14,7 @@ import os
 import sys
 
 from tg_drake.errors import TgDrakeError
+from tg_drake.outputs import check_output_dir, check_output_file
 
 # command name → module implementing it.
 COMMANDS: dict[str, str] = {
@@ -53,8 +54,6 @@ def check_outputs(args) -> None:
     A command whose output folder has a default computed from its other arguments gives it with
     `default_out(args)`.
     """
-    from tg_drake.outputs import check_output_dir, check_output_file
-
     for option, kind in OUTPUTS.get(args.command, {}).items():
         path = getattr(args, option)
         if path is None and option == "out" and hasattr(args._module, "default_out"):
