@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from grasp_helpers import grasp_pose, ranked, scene_with_box
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import ContactResults
@@ -29,8 +30,6 @@ from tg_drake.types import (
     PART_LABELS,
     GraspCandidates,
     GraspSemantics,
-    ObjectDescription,
-    PartBox,
     SceneDescription,
 )
 
@@ -38,42 +37,7 @@ from tg_drake.types import (
 NO_MODEL = MonitorModel(HandGeometries(frozenset(), frozenset(), frozenset(), frozenset()),
                         object_body=0, gripper_body=0)
 CONFIG = SupervisorConfig(planning_start=0.0, period=0.01, planning_timeout=0.5)
-GRASP_POINT = 0.055  # [m] along +y_G from the WSG body origin
 Q_MEASURED = np.array([0.1, -0.5, 0.05, -1.8, 0.0, 1.1, 0.2])  # a posture near IIWA_HOME
-
-
-def grasp_pose(p_W_grasp, approach_W, closing_W) -> np.ndarray:
-    y, x = np.asarray(approach_W, float), np.asarray(closing_W, float)
-    X = np.eye(4)
-    X[:3, :3] = np.column_stack([x, y, np.cross(x, y)])
-    X[:3, 3] = np.asarray(p_W_grasp, float) - GRASP_POINT * y
-    return X
-
-
-def scene_with_box(p_W_center, extents=(0.07, 0.07, 0.20)) -> SceneDescription:
-    """One upright box on the table, bottom / middle / top thirds as its parts."""
-    extents = np.asarray(extents, float)
-    X_WO = np.eye(4)
-    X_WO[:3, 3] = p_W_center
-    boxes = {}
-    for k, name in enumerate(("bottom", "middle", "top")):
-        X_WB = X_WO.copy()
-        X_WB[2, 3] += -extents[2] / 2 + extents[2] * (k + 0.5) / 3
-        boxes[name] = PartBox(X_WB, np.array([extents[0], extents[1], extents[2] / 3]) / 2)
-    box = ObjectDescription(
-        p_W=np.zeros((0, 3)), n_W=np.zeros((0, 3)), labels=np.zeros(0, int),
-        visible=np.zeros(0, bool), X_WO=X_WO, extents=extents, pose="upright",
-        pose_likelihood={"upright": 1.0}, part_probabilities=dict.fromkeys(boxes, 1.0),
-        part_boxes=boxes, pregrasp_X_WG=np.zeros((0, 4, 4)), pregrasp_parts=np.zeros(0, int))
-    return SceneDescription(objects=[box], X_WT=np.eye(4), target=0)
-
-
-def ranked(poses_and_parts) -> GraspCandidates:
-    X = np.array([X for X, _ in poses_and_parts])
-    parts = np.array([PART_LABELS.index(p) for _, p in poses_and_parts])
-    score = np.linspace(0.9, 0.5, len(parts))
-    return GraspCandidates(X_WG=X, parts=parts, p_part=score, p_local=np.ones(len(parts)),
-                           score=score)
 
 
 def semantics(grasp_probability=0.5, part=None, collisions=()) -> GraspSemantics:

@@ -80,7 +80,9 @@ class _LatchedPerception(LeafSystem):
             self._calc_status, prerequisites_of_calc=on_latch)
 
     def _perceive(self, context) -> SceneDescription:
-        raise NotImplementedError
+        """The scene from this system's inputs; each perception system defines it (raises
+        PerceptionError when there is nothing to describe)."""
+        raise NotImplementedError(f"{type(self).__name__} does not define _perceive")
 
     def get_perception_request_input_port(self):
         return self._request_port
