@@ -22,8 +22,16 @@ Each object lists the poses that suit it (upright / sideways / upsidedown; tools
 lying flat) with its resting transform X_TO (table-top frame T → object frame O): the object then
 rests on z = 0 of T with its origin above T's origin.
 
+User libraries (``tg-drake import-object --out DIR`` writes one) have the same format in a folder
+DIR of its own: ``DIR/library.yaml`` and ``DIR/<id>/``, plus imported objects' convex collision
+pieces ``<id>_collision_<k>.obj``. Their entries may add ``source`` (where the mesh came from),
+``labels`` (``derived`` | ``given``; absent = generated) and ``stable_poses`` (every resting pose
+found, most probable first). `add_library` registers one, `register_object` a single imported
+object; `get_object` looks in the shipped library first, then in the registered ones.
+
     tg-drake objects            # a table: id, category, size, mass, parts
     tg-drake objects --json
+    tg-drake objects --library DIR
 """
 
 from __future__ import annotations
@@ -72,6 +80,17 @@ class RestingPose:
 
 
 @dataclass(frozen=True)
+class StablePose(RestingPose):
+    """One stable resting pose found for an imported object; `pose` is its name among POSES, or
+    None when it is none of them (an object lying on an odd face)."""
+
+    probability: float = 0.0  # [1] of coming to rest in this pose when dropped at random
+
+
+LABEL_SOURCES = ("generated", "derived", "given")
+
+
+@dataclass(frozen=True)
 class LibraryObject:
     """One object of the library (fields as in library.yaml; SI units)."""
 
@@ -94,6 +113,15 @@ class LibraryObject:
     poses: dict  # pose name → RestingPose, for the poses that suit the object.
     n_vertices: int
     n_triangles: int
+    root: Path = None  # the library folder (its library.yaml and <id>/); the shipped library's
+    # when None
+    labels_source: str = "generated"  # an entry of LABEL_SOURCES: how the part labels were made
+    stable_poses: tuple = ()  # StablePose, most probable first; empty when the library lists none
+    source: dict | None = None  # where an imported object came from (file, sha256, units, ...)
+
+    @property
+    def shipped(self) -> bool:
+        return self.root is None or self.root == shipped_root()
 
     @property
     def is_tool(self) -> bool:
@@ -110,7 +138,7 @@ class LibraryObject:
 
     @property
     def directory(self) -> Path:
-        return Path(str(importlib.resources.files(PACKAGE))) / "objects" / self.id
+        return (shipped_root() if self.root is None else self.root) / self.id
 
     @property
     def sdf_path(self) -> Path:
@@ -126,12 +154,17 @@ class LibraryObject:
 
     @property
     def sdf_url(self) -> str:
-        """package:// URL of the SDF (Drake resolves it through models/package.xml)."""
-        return f"package://{PACKAGE}/objects/{self.id}/{self.id}.sdf"
+        """package:// URL of the SDF for the shipped library (Drake resolves it through
+        models/package.xml), file:///absolute/path for a user library."""
+        if self.shipped:
+            return f"package://{PACKAGE}/objects/{self.id}/{self.id}.sdf"
+        return self.sdf_path.resolve().as_uri()
 
     @property
     def mesh_url(self) -> str:
-        return f"package://{PACKAGE}/objects/{self.id}/{self.id}.obj"
+        if self.shipped:
+            return f"package://{PACKAGE}/objects/{self.id}/{self.id}.obj"
+        return self.mesh_path.resolve().as_uri()
 
     def resting_pose(self, pose: str) -> RestingPose:
         """The resting transform for `pose`; ScenarioError naming the poses that suit the object."""
@@ -142,12 +175,45 @@ class LibraryObject:
                                 f"allowed: {', '.join(self.poses)}")
         return self.poses[pose]
 
+    def stable_pose(self, k: int) -> StablePose:
+        """The k-th most probable stable pose (0 = the most probable); ScenarioError naming the
+        stable poses the object has."""
+        if not self.stable_poses:
+            raise ScenarioError(f"{self.id} lists no stable poses; give a `pose` among "
+                                + ", ".join(self.poses))
+        if isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < len(self.stable_poses):
+            raise ScenarioError(f"{self.id} has no stable pose {k!r}; allowed: "
+                                + describe_stable_poses(self))
+        return self.stable_poses[k]
+
+
+def describe_stable_poses(obj: LibraryObject) -> str:
+    """"0 (upright, p=0.61), 1 (sideways, p=0.30), ..." for messages."""
+    return ", ".join(f"{k} ({s.pose or 'unnamed'}, p={s.probability:.2f})"
+                     for k, s in enumerate(obj.stable_poses))
+
+
+def shipped_root() -> Path:
+    """The shipped library's folder (objects/ in the tg_drake_models package)."""
+    return Path(str(importlib.resources.files(PACKAGE))) / "objects"
+
 
 def library_path() -> Path:
-    return Path(str(importlib.resources.files(PACKAGE))) / "objects" / "library.yaml"
+    return shipped_root() / "library.yaml"
 
 
-def _object(obj_id: str, d: dict) -> LibraryObject:
+def _stable_poses(entries) -> tuple:
+    out = []
+    for v in entries:
+        pose = v.get("pose")
+        if pose is not None and pose not in POSES:
+            raise ValueError(f"stable pose name {pose!r} is none of {', '.join(POSES)}")
+        out.append(StablePose(pose, tuple(v["xyz"]), tuple(v["rpy"]), v["support_margin"],
+                              float(v["probability"])))
+    return tuple(out)
+
+
+def _object(obj_id: str, d: dict, root: Path | None = None) -> LibraryObject:
     iu = np.triu_indices(3)
     inertia = np.zeros((3, 3))
     inertia[iu] = d["inertia"]
@@ -165,12 +231,26 @@ def _object(obj_id: str, d: dict) -> LibraryObject:
         dimensions=MappingProxyType(dict(d["dimensions"])),
         parts=tuple(p for p in PART_LABELS if p in d["parts"]),
         grasp_widths=MappingProxyType(dict(d["grasp_widths"])),
-        poses=MappingProxyType(poses), n_vertices=d["n_vertices"], n_triangles=d["n_triangles"])
+        poses=MappingProxyType(poses), n_vertices=d["n_vertices"], n_triangles=d["n_triangles"],
+        root=root, labels_source=d.get("labels", "generated"),
+        stable_poses=_stable_poses(d.get("stable_poses") or ()),
+        source=None if d.get("source") is None else MappingProxyType(dict(d["source"])))
+
+
+def load_library(path: str | Path | None = None) -> MappingProxyType:
+    """Object id → LibraryObject of one library, in its order (the shipped one, by category then
+    instance, when `path` is None; else the library folder `path` or its library.yaml). Cached
+    per folder; does not register a user library (`add_library` does)."""
+    if path is None:
+        return _load_shipped()
+    root = Path(path).expanduser()
+    if root.name == "library.yaml":
+        root = root.parent
+    return _load_folder(root.resolve())
 
 
 @functools.cache
-def load_library() -> MappingProxyType:
-    """Object id → LibraryObject, in library order (by category, then instance). Cached."""
+def _load_shipped() -> MappingProxyType:
     path = library_path()
     if not path.is_file():
         raise ModelError("object library missing; run `python tools/make_objects.py`",
@@ -178,7 +258,7 @@ def load_library() -> MappingProxyType:
     with open(path) as f:
         data = yaml.safe_load(f)
     try:
-        objects = {k: _object(k, v) for k, v in data["objects"].items()}
+        objects = {k: _object(k, v, shipped_root()) for k, v in data["objects"].items()}
     except (KeyError, TypeError) as e:
         raise ModelError(f"malformed object library entry: {e}", file=str(path)) from None
     for o in objects.values():
@@ -188,12 +268,123 @@ def load_library() -> MappingProxyType:
     return MappingProxyType(objects)
 
 
+@functools.cache
+def _load_folder(root: Path) -> MappingProxyType:
+    """A user library; ModelError naming library.yaml and the field for a malformed one."""
+    path = root / "library.yaml"
+    if not root.is_dir():
+        raise ModelError("no such object library folder", file=str(root))
+    if not path.is_file():
+        raise ModelError("not an object library: it has no library.yaml (`tg-drake "
+                         "import-object --out DIR` writes one)", file=str(path))
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
+        raise ModelError(f"cannot read the object library: {' '.join(str(e).split())}",
+                         file=str(path)) from None
+    entries = data.get("objects") if isinstance(data, dict) else None
+    if not isinstance(entries, dict):
+        raise ModelError("expected a mapping `objects: {id: entry}`", file=str(path),
+                         field="objects")
+    objects = {}
+    for obj_id, d in entries.items():
+        field = f"objects.{obj_id}"
+        if not isinstance(d, dict):
+            raise ModelError("expected a mapping of the entry's fields", file=str(path),
+                             field=field)
+        missing = [k for k in REQUIRED_FIELDS if k not in d]
+        if missing:
+            raise ModelError(f"missing {', '.join(missing)}", file=str(path),
+                             field=f"{field}.{missing[0]}")
+        try:
+            o = _object(str(obj_id), d, root)
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as e:
+            raise ModelError(f"malformed entry: {e}", file=str(path), field=field) from None
+        if o.category not in CATEGORIES:
+            raise unknown_name("category", o.category, CATEGORIES, error=ModelError,
+                               file=str(path), field=f"{field}.category")
+        if o.labels_source not in LABEL_SOURCES:
+            raise unknown_name("label source", o.labels_source, LABEL_SOURCES,
+                               error=ModelError, file=str(path), field=f"{field}.labels")
+        if not o.sdf_path.is_file():
+            raise ModelError(f"{o.id}'s SDF is missing", file=str(o.sdf_path))
+        objects[o.id] = o
+    return MappingProxyType(objects)
+
+
+# The fields every library.yaml entry has (models/objects/library.yaml).
+REQUIRED_FIELDS = ("category", "material", "density", "part_materials", "mass", "volume",
+                   "cavity_volume", "cavity_centroid", "com", "inertia", "extents", "dimensions",
+                   "parts", "grasp_widths", "poses", "n_vertices", "n_triangles")
+
+# Registered user libraries (folder → objects) and single imported objects (id → object).
+_LIBRARIES: dict[Path, MappingProxyType] = {}
+_OBJECTS: dict[str, LibraryObject] = {}
+
+
+def _where(obj: LibraryObject) -> str:
+    return "the shipped library" if obj.shipped else f"the library {obj.root}"
+
+
+def _holder(obj_id: str) -> LibraryObject | None:
+    """The object registered (or shipped) under `obj_id`, or None."""
+    if obj_id in _load_shipped():
+        return _load_shipped()[obj_id]
+    for lib in _LIBRARIES.values():
+        if obj_id in lib:
+            return lib[obj_id]
+    return _OBJECTS.get(obj_id)
+
+
+def _check_clash(obj: LibraryObject) -> None:
+    other = _holder(obj.id)
+    if other is not None and other.directory.resolve() != obj.directory.resolve():
+        raise ModelError(f"object id {obj.id!r} is in both {_where(other)} and {_where(obj)}; "
+                         "give one of them another id")
+
+
+def add_library(path: str | Path) -> MappingProxyType:
+    """Registers the user library at folder `path` (get_object then finds its objects) and returns
+    its objects. Registering it again does nothing; an id another library holds is a ModelError
+    naming both libraries."""
+    lib = load_library(path)
+    root = next(iter(lib.values())).root if lib else Path(path).expanduser().resolve()
+    if root in _LIBRARIES:
+        return lib
+    for obj in lib.values():
+        _check_clash(obj)
+    _LIBRARIES[root] = lib
+    return lib
+
+
+def register_object(obj: LibraryObject) -> LibraryObject:
+    """Registers one (imported) object so that get_object finds it; again the same object does
+    nothing, another object under a registered id is a ModelError naming both."""
+    _check_clash(obj)
+    if _holder(obj.id) is None:
+        _OBJECTS[obj.id] = obj
+    return obj
+
+
+def registered_libraries() -> tuple[Path, ...]:
+    return tuple(_LIBRARIES)
+
+
+def forget_registered() -> None:
+    """Drops every registered library and object (tests)."""
+    _LIBRARIES.clear()
+    _OBJECTS.clear()
+
+
 def get_object(obj_id: str) -> LibraryObject:
-    """The library object `obj_id`; ScenarioError listing the valid ids when unknown."""
-    lib = load_library()
-    if obj_id not in lib:
-        raise unknown_name("object", obj_id, lib, error=ScenarioError)
-    return lib[obj_id]
+    """The object `obj_id` of the shipped library or a registered one; ScenarioError listing the
+    valid ids when unknown."""
+    obj = _holder(obj_id)
+    if obj is None:
+        known = list(_load_shipped()) + [i for lib in _LIBRARIES.values() for i in lib] \
+            + list(_OBJECTS)
+        raise unknown_name("object", obj_id, known, error=ScenarioError)
+    return obj
 
 
 def library_by_category() -> dict[str, tuple[LibraryObject, ...]]:
@@ -207,13 +398,13 @@ def _as_object(obj: LibraryObject | str) -> LibraryObject:
 
 
 @functools.cache
-def _mesh(obj_id: str):
-    o = get_object(obj_id)
+def _mesh(directory: Path, obj_id: str):
+    mesh_path, parts_path = directory / f"{obj_id}.obj", directory / f"{obj_id}_parts.npy"
     try:
-        text = o.mesh_path.read_text()
-        labels = np.load(o.parts_path)
+        text = mesh_path.read_text()
+        labels = np.load(parts_path)
     except OSError as e:
-        raise ModelError(f"cannot read {obj_id}'s mesh: {e}", file=str(o.directory)) from None
+        raise ModelError(f"cannot read {obj_id}'s mesh: {e}", file=str(directory)) from None
     lines = text.splitlines()
     V = np.array([ln.split()[1:4] for ln in lines if ln.startswith("v ")], float)
     F = np.array([[t.split("/")[0] for t in ln.split()[1:4]]
@@ -221,7 +412,7 @@ def _mesh(obj_id: str):
                  np.int64) - 1
     if len(labels) != len(V) or F.min() < 0 or F.max() >= len(V):
         raise ModelError(f"{obj_id}: {len(V)} vertices, {len(labels)} part labels, face indices "
-                         f"{F.min()}..{F.max()}", file=str(o.mesh_path))
+                         f"{F.min()}..{F.max()}", file=str(mesh_path))
     for a in (V, F, labels):
         a.setflags(write=False)
     return V, F, labels
@@ -230,9 +421,11 @@ def _mesh(obj_id: str):
 def mesh(obj: LibraryObject | str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(vertices (V, 3) [m] in O, triangles (F, 3) int, part label per vertex (V,) uint8).
 
-    Read-only arrays, cached. Triangles are anticlockwise seen from outside (outward normals).
+    Read-only arrays, cached per object folder. Triangles are anticlockwise seen from outside
+    (outward normals).
     """
-    return _mesh(_as_object(obj).id)
+    o = _as_object(obj)
+    return _mesh(o.directory, o.id)
 
 
 def box_centre(obj: LibraryObject | str) -> np.ndarray:
@@ -280,17 +473,26 @@ def sample_surface(obj: LibraryObject | str, *, n: int | None = None,
 def add_arguments(parser) -> None:
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--category", choices=CATEGORIES, help="only this category")
+    parser.add_argument("--library", metavar="DIR",
+                        help="list the user library in folder DIR instead of the shipped one")
 
 
 def _row(o: LibraryObject) -> dict:
-    return {"id": o.id, "category": o.category, "material": o.material,
-            "extents": list(o.extents), "mass": o.mass, "parts": list(o.parts),
-            "poses": list(o.poses), "cavity_volume": o.cavity_volume,
-            "sdf": o.sdf_url}
+    row = {"id": o.id, "category": o.category, "material": o.material,
+           "extents": list(o.extents), "mass": o.mass, "parts": list(o.parts),
+           "poses": list(o.poses), "cavity_volume": o.cavity_volume,
+           "sdf": o.sdf_url}
+    if not o.shipped:
+        row.update(labels=o.labels_source,
+                   stable_poses=[{"pose": p.pose, "probability": p.probability}
+                                 for p in o.stable_poses],
+                   source=None if o.source is None else dict(o.source))
+    return row
 
 
 def main(args) -> int:
-    objs = [o for o in load_library().values()
+    library = getattr(args, "library", None)
+    objs = [o for o in load_library(library).values()
             if args.category is None or o.category == args.category]
     if args.json:
         print(json.dumps([_row(o) for o in objs], indent=1))
