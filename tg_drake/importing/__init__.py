@@ -8,8 +8,19 @@ library's format. A core: it never imports the Drake systems framework, the stat
 Modules: source (what the user named → mesh file), mesh (load, units, up axis, repair), frame
 (object frame, part labels, dimensions), mass, poses (stable resting poses), collision (convex
 decomposition), library (the files; import_object, import_cached), report, cli.
+
+The names below load tg_drake.importing.library on first use, so that `tg-drake --help`, which
+imports tg_drake.importing.cli, does not import trimesh, CoACD and pydrake.
 """
 
-from tg_drake.importing.library import ImportOptions, ImportResult, import_cached, import_object
+from __future__ import annotations
+
+import importlib
 
 __all__ = ["ImportOptions", "ImportResult", "import_cached", "import_object"]
+
+
+def __getattr__(name: str):
+    if name in __all__:
+        return getattr(importlib.import_module("tg_drake.importing.library"), name)
+    raise AttributeError(f"module 'tg_drake.importing' has no attribute {name!r}")
