@@ -79,7 +79,7 @@ def mass_properties(V: np.ndarray, F: np.ndarray, *, watertight: bool, category:
             raise ModelError(f"{name} {value!r}; allowed: a positive number", file=file,
                              field=name)
     warnings = []
-    hull = trimesh.Trimesh(V, F, process=False).convex_hull
+    hull = trimesh.convex.convex_hull(V[np.unique(F)])  # of the vertices the triangles use
     hull_volume = float(hull.volume)
     vol, first, second, cap_area = capped_moments(V, F)
     if watertight and vol > 0:
