@@ -1,4 +1,5 @@
-"""Import, first steps: what the user names → mesh file (source), loading, units, up axis, repair."""
+"""Import, first steps: what the user names → mesh file (source), loading, units, up axis,
+repair."""
 
 from __future__ import annotations
 

@@ -10,12 +10,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import coacd
 import numpy as np
+import open3d
 import trimesh
 import vhacdx
 
+# isort: split
+import coacd  # after open3d: open3d fails to load (std::bad_cast) in a process that loaded coacd
+
 from tg_drake.errors import ModelError
+from tg_drake.importing.mesh import closed_with_caps
 
 # Parameters of each backend, in its own units.
 BACKENDS: dict[str, dict] = {
@@ -37,6 +41,11 @@ BACKENDS: dict[str, dict] = {
     },
 }
 MIN_PIECE_VOLUME = 1e-9  # [m³] (1 mm³) a smaller piece adds no contact: dropped.
+# The decomposition works on the mesh with its holes capped (an open mesh sends CoACD through its
+# slow manifold remeshing), decimated to this many triangles (quadric error, open3d): CoACD's time
+# grows with the triangle count, and 4000 triangles keep a household object's shape to well
+# under a millimetre. The pieces are convex hulls: they cover the decimated surface.
+DECOMPOSITION_TRIANGLES = 4000
 
 
 @dataclass(frozen=True)
@@ -51,12 +60,12 @@ def decompose(V: np.ndarray, F: np.ndarray, backend: str = "coacd") -> list[Conv
         raise ModelError(f"unknown collision backend {backend!r}; allowed: "
                          f"{', '.join(BACKENDS)}", field="collision")
     params = BACKENDS[backend]
+    Vd, Fd = decomposition_input(np.asarray(V, float), np.asarray(F, np.int64))
     if backend == "coacd":
         coacd.set_log_level("error")
-        raw = coacd.run_coacd(coacd.Mesh(np.asarray(V, float), np.asarray(F, np.int64)),
-                              **params)
+        raw = coacd.run_coacd(coacd.Mesh(Vd, Fd), **params)
     else:
-        raw = vhacdx.compute_vhacd(np.asarray(V, float), np.asarray(F, np.uint32), **params)
+        raw = vhacdx.compute_vhacd(Vd, Fd.astype(np.uint32), **params)
     pieces = []
     for v, _ in raw:
         hull = _hull(np.asarray(v, float))
@@ -70,21 +79,37 @@ def decompose(V: np.ndarray, F: np.ndarray, backend: str = "coacd") -> list[Conv
     return pieces
 
 
+def decomposition_input(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh the decomposition sees: holes capped, at most DECOMPOSITION_TRIANGLES."""
+    V, F = closed_with_caps(V, F)
+    if len(F) > DECOMPOSITION_TRIANGLES:
+        m = open3d.geometry.TriangleMesh(open3d.utility.Vector3dVector(V),
+                                         open3d.utility.Vector3iVector(F.astype(np.int32)))
+        m = m.simplify_quadric_decimation(DECOMPOSITION_TRIANGLES)
+        m.remove_degenerate_triangles()
+        m.remove_unreferenced_vertices()
+        V, F = np.asarray(m.vertices, float), np.asarray(m.triangles, np.int64)
+    return V, F
+
+
 def _hull(points: np.ndarray) -> ConvexPiece | None:
     if len(points) < 4:
         return None
-    try:
-        h = trimesh.convex.convex_hull(points)
-    except Exception:  # noqa: BLE001 - qhull on flat input
-        return None
-    if not h.is_volume or h.volume < MIN_PIECE_VOLUME:
-        return None
+    # a flat piece's hull has no volume: trimesh's centre of mass divides by it (a warning)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        try:
+            h = trimesh.convex.convex_hull(points)
+        except Exception:  # noqa: BLE001 - qhull on flat input
+            return None
+        if not h.is_volume or h.volume < MIN_PIECE_VOLUME:
+            return None
     return ConvexPiece(np.asarray(h.vertices, float), np.asarray(h.faces, np.int64))
 
 
 def piece_obj_text(piece: ConvexPiece, name: str) -> str:
     """Wavefront OBJ of a piece (metres, O)."""
-    v = "\n".join(f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in piece.vertices.tolist())
+    # 1 nm: a hull's near-coplanar facets stay convex when read back
+    v = "\n".join(f"v {x:.9f} {y:.9f} {z:.9f}" for x, y, z in piece.vertices.tolist())
     f = "\n".join(f"f {a} {b} {c}" for a, b, c in (piece.faces + 1).tolist())
     return f"# {name}: convex collision piece (metres, object frame O)\no {name}\n{v}\n{f}\n"
 

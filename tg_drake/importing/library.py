@@ -1,4 +1,5 @@
-"""Importing an object: a user's mesh → an entry of a library folder in the shipped library's format.
+"""Importing an object: a user's mesh → an entry of a library folder in the shipped library's
+format.
 
     import_object("mugs/blue_mug.obj", ImportOptions(category="cup"), Path("my_objects"))
 
@@ -28,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from scipy.spatial import cKDTree
 
 from tg_drake import objects
 from tg_drake.errors import ModelError, unknown_name
@@ -106,12 +108,16 @@ def import_object(source: str | Path, options: ImportOptions, out_dir: Path, *,
     obj_id = options.obj_id or src.name
     file = str(src.mesh_file)
     loaded = load(src.mesh_file)
-    given_labels = _read_labels(options.labels, len(loaded.vertices))
+    given_labels, label_points = _read_labels(options.labels, loaded, src.mesh_file)
     V_m, placement = to_metres_z_up(loaded.vertices, units=options.units,
                                     up_axis=options.up_axis, scale=src.scale, file=file)
     repaired = repair(V_m, loaded.faces, file=file)
     lap("load+repair")
-    labels_in = None if given_labels is None else given_labels[repaired.source_vertex]
+    labels_in = None
+    if given_labels is not None:  # each repaired vertex takes the label of the nearest labelled
+        P_m = (label_points * np.asarray(src.scale) * placement.factor) @ UP_AXES[
+            placement.up_axis].T
+        labels_in = given_labels[cKDTree(P_m).query(repaired.vertices)[1]]
     frame = derive_frame(repaired.vertices, repaired.faces, options.category, labels=labels_in)
     X_OM = np.asarray(frame.X_OM, float)
     V_O = repaired.vertices @ X_OM[:3, :3].T + X_OM[:3, 3]
@@ -151,16 +157,21 @@ def import_object(source: str | Path, options: ImportOptions, out_dir: Path, *,
                         warnings, pics)
 
 
-def _read_labels(path: Path | None, n_vertices: int) -> np.ndarray | None:
+def _read_labels(path: Path | None, loaded, mesh_file: Path):
+    """(labels (N,) uint8, the N points of the file they label) or (None, None). A label file
+    holds one label per vertex of the file: an OBJ's `v` lines, else the vertices as loaded."""
     if path is None:
-        return None
+        return None, None
     try:
         labels = np.load(Path(path), allow_pickle=False)
     except (OSError, ValueError) as e:
         raise ModelError(f"cannot read the part labels: {e}; allowed: a .npy array of one "
                          "label per vertex", file=str(path), field="labels") from None
-    if labels.ndim != 1 or len(labels) != n_vertices:
-        raise ModelError(f"{labels.shape} labels for a mesh of {n_vertices} vertices; allowed: "
+    points = loaded.vertices
+    if mesh_file.suffix.lower() == ".obj" and len(labels) != len(points):
+        points = _obj_vertices(mesh_file)
+    if labels.ndim != 1 or len(labels) != len(points):
+        raise ModelError(f"{labels.shape} labels for a mesh of {len(points)} vertices; allowed: "
                          "one label per vertex, in the file's vertex order", file=str(path),
                          field="labels")
     if not np.issubdtype(labels.dtype, np.integer) or labels.min() < 0 or \
@@ -168,7 +179,17 @@ def _read_labels(path: Path | None, n_vertices: int) -> np.ndarray | None:
         raise ModelError(f"labels {labels.min()}..{labels.max()} ({labels.dtype}); allowed: "
                          f"integers 0..{len(PART_LABELS) - 1} ({', '.join(PART_LABELS)})",
                          file=str(path), field="labels")
-    return labels.astype(np.uint8)
+    return labels.astype(np.uint8), points
+
+
+def _obj_vertices(path: Path) -> np.ndarray:
+    """The points of an OBJ file's `v` lines, in file order (trimesh drops unused ones)."""
+    rows = [ln.split()[1:4] for ln in path.read_text(errors="replace").splitlines()
+            if ln.startswith("v ")]
+    try:
+        return np.array(rows, float).reshape(-1, 3)
+    except ValueError:
+        raise ModelError("malformed `v` lines", file=str(path)) from None
 
 
 def _rnd(x, digits: int) -> float:
@@ -226,7 +247,7 @@ def obj_text(obj_id: str, V: np.ndarray, normals: np.ndarray, F: np.ndarray) -> 
 
 
 def sdf_text(obj_id: str, entry: dict, mp, piece_uris: list[str]) -> str:
-    I, c = mp.inertia, mp.com
+    J, c = mp.inertia, mp.com
     return f"""<?xml version="1.0"?>
 <!-- Written by tg-drake import-object from {Path(entry['source']['file']).name}:
      mass {mp.mass:.4f} kg ({mp.solid}); collision: {len(piece_uris)} convex pieces. -->
@@ -237,12 +258,12 @@ def sdf_text(obj_id: str, entry: dict, mp, piece_uris: list[str]) -> str:
         <pose>{c[0]:.6f} {c[1]:.6f} {c[2]:.6f} 0 0 0</pose>
         <mass>{mp.mass:.9g}</mass>
         <inertia>
-          <ixx>{I[0, 0]:.9e}</ixx>
-          <ixy>{I[0, 1]:.9e}</ixy>
-          <ixz>{I[0, 2]:.9e}</ixz>
-          <iyy>{I[1, 1]:.9e}</iyy>
-          <iyz>{I[1, 2]:.9e}</iyz>
-          <izz>{I[2, 2]:.9e}</izz>
+          <ixx>{J[0, 0]:.9e}</ixx>
+          <ixy>{J[0, 1]:.9e}</ixy>
+          <ixz>{J[0, 2]:.9e}</ixz>
+          <iyy>{J[1, 1]:.9e}</iyy>
+          <iyz>{J[1, 2]:.9e}</iyz>
+          <izz>{J[2, 2]:.9e}</izz>
         </inertia>
       </inertial>
       <visual name="visual">

@@ -260,14 +260,14 @@ def vertex_normals(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     return out
 
 
-def hole_caps(V: np.ndarray, F: np.ndarray) -> np.ndarray:
-    """(C, 3, 3) triangles that close every hole of (V, F): each boundary loop (a connected
-    set of boundary edges) is fanned from its vertices' centroid, wound against the boundary edges,
-    so that the surface with its caps is closed. Loops of two pieces that meet at a seam give caps
-    that cancel in any surface integral."""
+def closed_with_caps(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(V', F') the mesh with every hole closed: each boundary loop (a connected set of boundary
+    edges) fanned from its vertices' centroid (a vertex appended to V), wound against the
+    boundary edges so that the surface with its caps is closed. F' = F followed by the caps. Loops
+    of two pieces that meet at a seam give caps that cancel in any surface integral."""
     B = boundary_edges(F)
     if len(B) == 0:
-        return np.zeros((0, 3, 3))
+        return V, F
     ids, inv = np.unique(B, return_inverse=True)
     inv = inv.reshape(B.shape)
     n = len(ids)
@@ -277,8 +277,14 @@ def hole_caps(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     centre = np.zeros((comp.max() + 1, 3))
     np.add.at(centre, comp, V[ids])
     centre /= counts[:, None]
-    c = centre[comp[inv[:, 0]]]
-    return np.stack([c, V[B[:, 1]], V[B[:, 0]]], axis=1)
+    caps = np.stack([len(V) + comp[inv[:, 0]], B[:, 1], B[:, 0]], axis=1)
+    return np.vstack([V, centre]), np.vstack([F, caps])
+
+
+def hole_caps(V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """(C, 3, 3) the triangles `closed_with_caps` adds."""
+    V2, F2 = closed_with_caps(V, F)
+    return V2[F2[len(F):]]
 
 
 def capped_moments(V: np.ndarray, F: np.ndarray):

@@ -1,12 +1,12 @@
 """Stable resting poses of an imported object (trimesh.poses.compute_stable_poses) and their names.
 
-trimesh finds the convex-hull faces the object can rest on and the probability that it lands on each
-when dropped in a random orientation. Each becomes X_TO (table-top frame T → object frame O) as
-xyz + Drake's RollPitchYaw, resting on z = 0 with O's origin above T's origin and the smallest
-rotation that puts the face down (so the yaw is that of the shipped library's poses). Names, by where
-O's z points: containers `upright` (up), `upsidedown` (down), `sideways` (level); tools lie flat
-with O's z up, which is their `sideways`. A pose further than MAX_TILT from these has no name. Each
-name goes to its most probable pose.
+trimesh finds the convex-hull faces the object can rest on and the probability that it lands on
+each when dropped in a random orientation. Each becomes X_TO (table-top frame T → object frame O)
+as xyz + Drake's RollPitchYaw, resting on z = 0 with O's origin above T's origin and the smallest
+rotation that puts the face down (so the yaw is that of the shipped library's poses). Names, by
+where O's z points: containers `upright` (up), `upsidedown` (down), `sideways` (level); tools lie
+flat with O's z up, which is their `sideways`. A pose further than MAX_TILT from these has no name.
+Each name goes to its most probable pose.
 """
 
 from __future__ import annotations

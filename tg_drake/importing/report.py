@@ -1,7 +1,8 @@
 """What an import decided, as one screen of text and a picture of the object in each resting pose.
 
-The pictures colour the parts as every other picture of the project does (tg_drake.types.PART_COLORS,
-the paper's Fig. 4) and draw the object's vertices in the table frame T on the table plane.
+The pictures colour the parts as every other picture of the project does
+(tg_drake.types.PART_COLORS, the paper's Fig. 4) and draw the object's vertices in the table frame
+T on the table plane.
 """
 
 from __future__ import annotations
@@ -80,7 +81,8 @@ def text(d: Decisions, warnings: tuple[str, ...]) -> str:
     ]
     for k, s in enumerate(d.poses[:MAX_PICTURES]):
         r = s.resting
-        lines.append(f"    {k}: {s.name or '-':10s} p={s.probability:.2f}  z={1000 * r.xyz[2]:.1f} mm"
+        lines.append(f"    {k}: {s.name or '-':10s} p={s.probability:.2f}  "
+                     f"z={1000 * r.xyz[2]:.1f} mm"
                      f"  rpy=[{', '.join(f'{np.degrees(a):.0f}' for a in r.rpy)}]°  support "
                      f"margin {1000 * r.support_margin:.1f} mm")
     if len(d.poses) > MAX_PICTURES:
