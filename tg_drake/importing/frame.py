@@ -19,8 +19,7 @@ Containers (pan, pot, cup, glass, bowl, bottle, can):
   cut belongs to the part above, as in tools/make_objects.py), plus the handle;
 - an inner surface (faces turned towards the axis, not downwards) over at least OPEN_DEPTH of the
   height makes an open vessel: wall = outer − inner radius across the wall, base = height of the
-  inner bottom, cavity = the water filling the inner surface up to the rim's inner edge (half a
-  wall below the crest: the rim is taken as rounded over the wall). A closed body (a bottle or can
+  inner bottom, cavity = the water filling the inner surface up to the rim's lowest point. A closed body (a bottle or can
   scanned from outside) has no inner surface: the wall is a prior (WALL_PRIOR) and the cavity the
   enclosed volume less a shell of that thickness (first order: section area less perimeter × wall).
 
@@ -32,15 +31,19 @@ Tools (hammer, knife, screwdriver, cooking_tool):
   thinnest principal axis: the one holding the centre of mass lowest. x is the long axis made
   perpendicular to z; y = z × x; origin at the bottom centre of the bounding box in O;
 - handle versus usable area: the section width (along y) and thickness (along z) profiles along x
-  are fitted, as logarithms, by two constant segments; the split is the profile's crossing of the
-  two levels' mean next to the best step. Which segment is the usable area is a rule per category:
+  are fitted, as logarithms, by two constant segments; the split is where one profile, next to the
+  best step, has gone a fraction of the way from the handle's level to the usable area's. Which
+  segment is the usable area, and where it begins, is a rule per category (TOOL_RULES):
 
-  - hammer: the head — the wider segment;
-  - knife: the blade — the thinner segment;
-  - screwdriver: the shaft and tip — the narrower segment;
-  - cooking_tool: the spatula head or the ladle bowl — the wider segment;
+  - hammer: the head — the wider segment, from a quarter of the way up the width's step;
+  - knife: the blade — the thinner segment, from where the handle has thinned a fifth of the way
+    (the bolster is the blade's);
+  - screwdriver: the shaft and tip — the narrower segment, from halfway down the width's step (the
+    handle's tapered nose is handle);
+  - cooking_tool: the spatula head or the ladle bowl — the wider segment, from a quarter of the
+    way up the width's step (a narrowing neck is handle);
   - unknown category: the segment less like a hand grip (section further from GRIP_SECTION in
-    log width + log thickness), said in the notes.
+    log width + log thickness), from halfway along the larger step; said in the notes.
 
   x points from the handle to the usable area.
 
@@ -87,7 +90,21 @@ WALL_PRIOR_DEFAULT = 0.003
 REVOLUTION_MIN = 0.5
 REVOLUTION_TOLERANCE = 0.03  # normal lines within this share of the radius (and ≥ 2 mm) cross the axis
 MAX_CONTAINER_ASPECT = 6.0  # height / diameter: bottles reach about 4.5, a standing screwdriver 7
-TOOL_BINS = 100  # stations of the section profile along a tool's length
+TOOL_BINS = 200  # stations of the section profile along a tool's length
+# Per tool category: which of the two segments is the usable area ("wider" or "narrower" in the
+# profile `channel`: 0 width, 1 thickness), and where the handle ends: where that profile has gone
+# `fraction` of the way (in logarithms) from the handle's level towards the usable area's.
+TOOL_RULES = {
+    # the head: wider; it begins where the section has widened a quarter of the way
+    "hammer": ("wider", 0, 0.25, "the head is the wider segment"),
+    # the blade: thinner; it begins where the handle starts thinning (the bolster is the blade's)
+    "knife": ("narrower", 1, 0.2, "the blade is the thinner segment, from where the handle thins"),
+    # the shaft and tip: narrower; the handle's tapered nose is still handle
+    "screwdriver": ("narrower", 0, 0.5, "the shaft and tip are the narrower segment"),
+    # the spatula head or ladle bowl: wider, from where the section has widened a quarter of the
+    # way (a narrowing neck is handle)
+    "cooking_tool": ("wider", 0, 0.25, "the head or bowl is the wider segment"),
+}
 GRIP_SECTION = (0.025, 0.02)  # [m] width, thickness of a typical hand grip (unknown category)
 TUKEY_C = 4.685  # Tukey biweight constant (95 % efficiency under Gaussian noise)
 
@@ -434,7 +451,12 @@ def _container(V, F, N, area, category, notes):
         up = (Ns[:, 2] > 0.9) & (np.linalg.norm(P[:, :2] - c, axis=1) < 0.5 * R_in[cav_idx[0]]) \
             & (P[:, 2] < lo + 0.25 * (hi - lo))
         base = float(np.median(P[up, 2]) - bottom) if up.sum() >= 5 else float(lo - dz / 2 - bottom)
-        fill = top - wall / 2
+        # brim-full: water stands up to the rim's lowest point (the lowest sector's crest)
+        bv = p_O[body_v]
+        sec_v = np.minimum(((np.arctan2(bv[:, 1], bv[:, 0]) + np.pi) / (2 * np.pi) * SECTORS)
+                           .astype(int), SECTORS - 1)
+        crest = _sector_reduce(sec_v, bv[:, 2], SECTORS, np.maximum, -np.inf)
+        fill = bottom + float(crest[np.isfinite(crest)].min())
         full = cav_cut & (levels <= fill) & (levels >= bottom + base)
         with np.errstate(all="ignore"):
             sq = np.where(in_occ, rin ** 2, np.nan)
@@ -445,8 +467,8 @@ def _container(V, F, N, area, category, notes):
         dims.update(wall=wall, base=base)
         notes.append(f"open vessel: an inner surface over {100 * depth / H:.0f} % of the height; "
                      f"wall {1000 * wall:.1f} mm (outer − inner radius across the wall), base "
-                     f"{1000 * base:.1f} mm; cavity filled to the rim's inner edge "
-                     f"{1000 * (fill - bottom):.1f} mm up (half a wall below the crest)")
+                     f"{1000 * base:.1f} mm; cavity filled to the rim's lowest point, "
+                     f"{1000 * (fill - bottom):.1f} mm up")
         open_wall = wall
     else:
         wall = WALL_PRIOR.get(category, WALL_PRIOR_DEFAULT)
@@ -567,10 +589,23 @@ def _tool(V, F, N, area, category, notes):
                          np.maximum(thick, 0.1 * thick.max())], 1))
     k = _two_segments(S)
     lvl_a, lvl_b = S[:k].mean(0), S[k:].mean(0)
-    ch = int(np.argmax(np.abs(lvl_b - lvl_a)))
-    mid = 0.5 * (lvl_a[ch] + lvl_b[ch])
-    sig = S[:, ch] - mid
-    # the crossing of the dominant profile's mid level nearest the step
+    wa, wb = np.exp(lvl_a), np.exp(lvl_b)  # (width, thickness) of either segment
+    if category in TOOL_RULES:
+        usable, ch, frac, rule = TOOL_RULES[category]
+        sign = 1 if usable == "wider" else -1
+        usable_high = sign * (lvl_b[ch] - lvl_a[ch]) > 0
+    else:
+        ch, frac = int(np.argmax(np.abs(lvl_b - lvl_a))), 0.5
+        g = np.log(np.array(GRIP_SECTION))
+        da, db = np.abs(np.log(wa) - g).sum(), np.abs(np.log(wb) - g).sum()
+        usable_high = db > da
+        rule = ("category unknown: the handle is the segment whose section is nearer a hand "
+                "grip's (a guess)")
+    # the segments' typical sections (medians: rounded ends and tapering tips do not count)
+    med_a, med_b = np.median(S[:k, ch]), np.median(S[k:, ch])
+    h_lvl, u_lvl = (med_a, med_b) if usable_high else (med_b, med_a)
+    sig = S[:, ch] - (h_lvl + frac * (u_lvl - h_lvl))
+    # the crossing of that level nearest the step
     cross = np.nonzero(np.sign(sig[:-1]) != np.sign(sig[1:]))[0]
     if len(cross):
         j = int(cross[np.argmin(np.abs(cross + 0.5 - k))])
@@ -578,22 +613,6 @@ def _tool(V, F, N, area, category, notes):
         split = float(xc[j] + t * (xc[j + 1] - xc[j]))
     else:
         split = float(edges[k])
-    wa, wb = np.exp(lvl_a), np.exp(lvl_b)  # (width, thickness) of either segment
-    if category in ("hammer", "cooking_tool"):
-        usable_high = wb[0] > wa[0]
-        rule = "the usable area is the wider segment"
-    elif category == "knife":
-        usable_high = wb[1] < wa[1]
-        rule = "the blade is the thinner segment"
-    elif category == "screwdriver":
-        usable_high = wb[0] < wa[0]
-        rule = "the shaft and tip are the narrower segment"
-    else:
-        g = np.log(np.array(GRIP_SECTION))
-        da, db = np.abs(np.log(wa) - g).sum(), np.abs(np.log(wb) - g).sum()
-        usable_high = db > da
-        rule = ("category unknown: the handle is the segment whose section is nearer a hand "
-                "grip's (a guess)")
     if not usable_high:
         R = np.stack([-x, -y, z])
         qv = V @ R.T
