@@ -10,8 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from pydrake.geometry import AddCompliantHydroelasticProperties, AddContactMaterial, Box
-from pydrake.geometry import ProximityProperties
+from pydrake.geometry import (
+    AddCompliantHydroelasticProperties,
+    AddContactMaterial,
+    Box,
+    ProximityProperties,
+)
 from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlantConfig

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
+from scipy.sparse.csgraph import breadth_first_order, connected_components
 from scipy.spatial import cKDTree
 
 from tg_drake.errors import ModelError
@@ -198,7 +198,8 @@ def repair(V: np.ndarray, F: np.ndarray, *, file: str | None = None) -> Repaired
                          "triangle soup, not a surface); allowed: a connected surface mesh",
                          file=file)
     before = _face_normals(m.vertices, m.faces)
-    trimesh.repair.fix_winding(m)
+    m.faces = consistent_winding(np.asarray(m.faces, np.int64), m.face_adjacency,
+                                 m.face_adjacency_edges)
     _orient_outward(m)
     flipped = int((np.einsum("ij,ij->i", before, _face_normals(m.vertices, m.faces)) < 0).sum())
     if flipped:
@@ -221,6 +222,43 @@ def repair(V: np.ndarray, F: np.ndarray, *, file: str | None = None) -> Repaired
     src = cKDTree(V).query(Vr)[1]
     return RepairedMesh(Vr, Fr, normals, np.asarray(src, np.int64), tuple(repairs), pieces,
                         bool(m.is_watertight), n_boundary)
+
+
+def consistent_winding(F: np.ndarray, adjacency: np.ndarray, shared: np.ndarray) -> np.ndarray:
+    """F with triangles flipped so that neighbours traverse their shared edge in opposite
+    directions (trimesh.repair.fix_winding's result, vectorised: its per-triangle loop takes
+    seconds on a scan). `adjacency` (A, 2) pairs of neighbouring triangles, `shared` (A, 2) the
+    vertices of their shared edge (trimesh's face_adjacency, face_adjacency_edges). Each
+    connected piece keeps its first triangle's winding; flips propagate along a breadth-first
+    spanning tree."""
+    if len(adjacency) == 0:
+        return F
+    def forward(f, u, v):  # whether triangle f goes u → v
+        k = np.argmax(F[f] == u[:, None], axis=1)
+        return F[f, (k + 1) % 3] == v
+    a, b = adjacency[:, 0], adjacency[:, 1]
+    u, v = shared[:, 0], shared[:, 1]
+    flip_edge = (forward(a, u, v) == forward(b, u, v)).astype(np.int8)  # same way: one flips
+    n = len(F)
+    g = coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n)).tocsr()
+    g = g + g.T
+    edge_of = {}
+    for i, j, x in zip(a.tolist(), b.tolist(), flip_edge.tolist(), strict=True):
+        edge_of[(i, j)] = edge_of[(j, i)] = x
+    _, comp = connected_components(g, directed=False)
+    flip = np.zeros(n, bool)
+    seen = np.zeros(comp.max() + 1, bool)
+    for root in range(n):
+        if seen[comp[root]]:
+            continue
+        seen[comp[root]] = True
+        order, pred = breadth_first_order(g, root, directed=False)
+        for node in order[1:].tolist():
+            p = int(pred[node])
+            flip[node] = flip[p] ^ bool(edge_of[(p, node)])
+    out = F.copy()
+    out[flip] = out[flip][:, ::-1]
+    return out
 
 
 def _face_normals(V, F):

@@ -110,8 +110,10 @@ def stable_poses(V: np.ndarray, F: np.ndarray, com: np.ndarray, *, is_tool: bool
         R = rot_to(down_O / np.linalg.norm(down_O), np.array([0.0, 0.0, -1.0]))
         z_T = R[:, 2]
         name = pose_name(z_T, is_tool=is_tool)
-        if name == "upsidedown" and abs(down_O[2] - 1) < 1e-9:
-            R = np.diag([1.0, -1.0, -1.0])  # a half turn about x, as the shipped library's
+        if name == "upsidedown":  # a half turn about x, as the shipped library's, then the tilt
+            Rx = np.diag([1.0, -1.0, -1.0])
+            d = Rx @ down_O
+            R = rot_to(d / np.linalg.norm(d), np.array([0.0, 0.0, -1.0])) @ Rx
         if is_tool and name == "sideways" and abs(down_O[2] + 1) < 1e-6:
             R = np.eye(3)
         V_T = hull_V @ R.T
