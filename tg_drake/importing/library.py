@@ -322,7 +322,8 @@ def merge_entry(path: Path, obj_id: str, entry: dict) -> None:
 def load_object(library_dir: Path, obj_id: str) -> objects.LibraryObject:
     """The object `obj_id` of the library folder, read back through tg_drake.objects."""
     load = objects.load_library
-    if "path" in inspect.signature(load).parameters:  # user libraries (issue 18's objects.py)
+    if inspect.signature(load).parameters:  # load_library(path): issue 18's user libraries
+        # (uncached: the folder was just written, an earlier read of it is stale)
         lib = getattr(load, "__wrapped__", load)(Path(library_dir))
         return lib[obj_id]
     # the shipped-library-only objects.py: the entry through its reader (directory not yet root)
