@@ -227,7 +227,10 @@ def _entry(d: report.Decisions, frame, options: ImportOptions, src) -> dict:
         "n_vertices": int(len(V)),
         "n_triangles": int(len(d.mesh.faces)),
         "source": {"file": str(Path(src.given).resolve()), "sha256": src.sha256(),
-                   "units": d.placement.units, "scale": _sig(d.placement.factor),
+                   "units": d.placement.units,
+                   # [m per file unit]: the units' factor times a model file's <scale>
+                   "scale": _sig(d.placement.factor) if src.scale == (1.0, 1.0, 1.0)
+                   else [_sig(d.placement.factor * s) for s in src.scale],
                    "up_axis": d.placement.up_axis},
         "labels": d.labels_source,
         "stable_poses": [{"pose": s.name, "probability": _rnd(s.probability, 4),

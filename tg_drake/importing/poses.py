@@ -103,8 +103,8 @@ def stable_poses(V: np.ndarray, F: np.ndarray, com: np.ndarray, *, is_tool: bool
                                                           n_samples=1, seed=seed)
     hull_V = np.asarray(m.convex_hull.vertices)
     found = []
-    for X, p in zip(transforms, probs, strict=True):
-        if p < MIN_PROBABILITY:
+    for k, (X, p) in enumerate(zip(transforms, probs, strict=True)):
+        if p < MIN_PROBABILITY and k > 0:  # (trimesh sorts them: the most probable stays)
             continue
         down_O = X[:3, :3].T @ np.array([0.0, 0.0, -1.0])  # the table's normal, into it, in O
         R = rot_to(down_O / np.linalg.norm(down_O), np.array([0.0, 0.0, -1.0]))
