@@ -24,6 +24,7 @@ COMMANDS: dict[str, str] = {
     "render": "tg_drake.render",
     "run": "tg_drake.run",
     "eval": "tg_drake.evaluation.cli",
+    "import-object": "tg_drake.importing.cli",
 }
 
 # command → its options that name a path it writes, and whether each is a "folder" or a "file".
@@ -33,6 +34,7 @@ OUTPUTS: dict[str, dict[str, str]] = {
     "render": {"out": "folder"},
     "run": {"out": "folder"},
     "eval": {"out": "folder", "tables": "folder"},
+    "import-object": {"out": "folder"},
 }
 
 
