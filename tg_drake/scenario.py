@@ -568,15 +568,8 @@ def resolve_objects(scenario: Scenario, *, where: str = "<scenario>",
     nothing), setting each mesh entry's `id` to the imported object's. Paths are made absolute
     (against `base_dir`, else the current folder), so that calling it again anywhere — the station
     does — gives the same objects."""
-    for i, text in enumerate(scenario.object_libraries):
-        f = f"object_libraries[{i}]"
-        try:
-            path = _resolve_path(text, base_dir)
-            add_library(path)
-        except (ScenarioError, ModelError) as e:
-            raise ScenarioError(e.message + (f" ({e.file})" if e.file else ""), file=where,
-                                field=f) from None
-        scenario.object_libraries[i] = str(path)
+    scenario.object_libraries[:] = add_object_libraries(scenario.object_libraries, where=where,
+                                                        base_dir=base_dir)
     for i, placement in enumerate(scenario.objects):
         f = f"objects[{i}]"
         if not placement.mesh:
@@ -614,6 +607,22 @@ def resolve_objects(scenario: Scenario, *, where: str = "<scenario>",
 
 
 _DEFAULT_PLACEMENT = ObjectPlacement()
+
+
+def add_object_libraries(folders, *, where: str = "<scenario>", base_dir: str | Path | None = None,
+                         field: str = "object_libraries") -> list[str]:
+    """Registers user object libraries (`tg_drake.objects.add_library`) named by paths relative to
+    `base_dir` (or package://); returns their absolute paths. ScenarioError naming `field`[i]."""
+    out = []
+    for i, text in enumerate(folders):
+        try:
+            path = _resolve_path(text, base_dir)
+            add_library(path)
+        except (ScenarioError, ModelError) as e:
+            raise ScenarioError(e.message + (f" ({e.file})" if e.file else ""), file=where,
+                                field=f"{field}[{i}]") from None
+        out.append(str(path))
+    return out
 
 
 def _check_mesh_entry(placement: ObjectPlacement, where: str, f: str) -> None:
