@@ -434,13 +434,14 @@ def _check_raw_objects(doc, where: str) -> None:
     for i, entry in enumerate(objects if isinstance(objects, list) else []):
         if not isinstance(entry, dict):
             continue
-        if ("id" in entry) == ("mesh" in entry):
+        given = {k for k, v in entry.items() if v not in (None, "")}  # a dump writes defaults
+        if ("id" in given) == ("mesh" in given):
             raise ScenarioError(
-                ("both `id` and `mesh` are given" if "id" in entry else "neither `id` nor `mesh` "
+                ("both `id` and `mesh` are given" if "id" in given else "neither `id` nor `mesh` "
                  "is given") + "; an object is either `{id: ID, ...}` (a library object, see "
                  "`tg-drake objects`) or `{mesh: FILE_OR_FOLDER, ...}` (imported)",
                 file=where, field=f"objects[{i}]")
-        if "pose" in entry and "resting" in entry:
+        if "pose" in given and "resting" in given:
             raise ScenarioError("give either `pose` (upright, sideways, upsidedown) or "
                                 "`resting` (auto or K), not both", file=where,
                                 field=f"objects[{i}].resting")

@@ -171,3 +171,15 @@ def test_import_errors_name_the_entry_and_field(tmp_path, fake_importer):
     with pytest.raises(ScenarioError, match="30 m across") as e:
         load_scenario(path)
     assert e.value.field == "objects[0].units"
+
+
+def test_a_dumped_scenario_loads_again(tmp_path):
+    from pydrake.common.yaml import yaml_dump_typed
+
+    from tg_drake.scenario import Scenario
+    copy_object("cup_01", "my_mug", tmp_path / "lib")
+    path = _write(tmp_path, "object_libraries: [lib]\nobjects: [{id: my_mug, xy: [0, 0.1]}]\n")
+    text = yaml_dump_typed(load_scenario(path), schema=Scenario)
+    again = _write(tmp_path / "again", text)
+    scenario = load_scenario(again)  # every default written out: pose with resting null, ...
+    assert scenario.objects[0].id == "my_mug" and scenario.objects[0].xy == [0, 0.1]
