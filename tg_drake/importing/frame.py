@@ -48,8 +48,10 @@ Tools (hammer, knife, screwdriver, cooking_tool):
   x points from the handle to the usable area.
 
 Category None: a container when the surface is a body of revolution about a vertical axis
-(REVOLUTION_MIN of the area with horizontal normals has normal lines through one axis) and not
-slender (height below MAX_CONTAINER_ASPECT diameters); otherwise a tool. Said in the notes.
+(REVOLUTION_MIN of the area with horizontal normals has normals pointing at one axis), not
+slender (height at most MAX_CONTAINER_ASPECT body diameters) and not dwarfed by a handle (at most
+MAX_CONTAINER_REACH body diameters across) whose body spans at least MIN_BODY_SHARE of its
+height; otherwise a tool. Said in the notes.
 
 Dimensions [m] — containers: height (body, handle excluded), diameter (the body's largest), wall,
 base, handle_length (how far the handle reaches out from the wall); tools: length, width,
@@ -88,8 +90,15 @@ OPEN_DEPTH = 0.3  # an inner surface over this share of the height makes an open
 WALL_PRIOR = {"bottle": 0.0015, "can": 0.0002}
 WALL_PRIOR_DEFAULT = 0.003
 REVOLUTION_MIN = 0.5
-REVOLUTION_TOLERANCE = 0.03  # normal lines within this share of the radius (and ≥ 2 mm) cross the axis
+# [°] a normal pointing this close at the axis belongs to a body of revolution (a 24-gon's facets
+# are 7.5° off at their edges)
+REVOLUTION_ANGLE = 10.0
 MAX_CONTAINER_ASPECT = 6.0  # height / diameter: bottles reach about 4.5, a standing screwdriver 7
+# longest horizontal extent / body diameter: a long-handled saucepan reaches about 2.3, a ladle 4
+MAX_CONTAINER_REACH = 3.0
+# body height / overall height: a pan's handle rises above its rim (body 0.67 of it); a ladle
+# standing on its bowl is mostly handle (about 0.1)
+MIN_BODY_SHARE = 0.5
 TOOL_BINS = 200  # stations of the section profile along a tool's length
 # Per tool category: which of the two segments is the usable area ("wider" or "narrower" in the
 # profile `channel`: 0 width, 1 thickness), and where the handle ends: where that profile has gone
@@ -327,16 +336,15 @@ def _apply(X, V):
 
 
 def _revolution_score(P, N):
-    """(share of the horizontal-normal surface whose normal lines cross one vertical axis, axis
-    (x, y), the median radius of those samples)."""
+    """(share of the horizontal-normal surface whose normals point at one vertical axis, within
+    REVOLUTION_ANGLE; the axis (x, y); the median radius of those samples [m])."""
     c, dist = _axis_centre(P, N)
     use = np.isfinite(dist)
     if c is None or use.sum() < 10:
         return 0.0, c, 0.0
     r = np.linalg.norm(P[use, :2] - c, axis=1)
-    R = float(np.median(r))
-    tol = max(0.002, REVOLUTION_TOLERANCE * R)
-    return float(np.mean(dist[use] < tol)), c, R
+    hit = dist[use] < math.sin(math.radians(REVOLUTION_ANGLE)) * r
+    return float(np.mean(hit)), c, float(np.median(r[hit])) if hit.any() else 0.0
 
 
 # ------------------------------------------------------------------------------------------------
@@ -381,9 +389,10 @@ def _container(V, F, N, area, category, notes):
     kv = np.clip(((V[:, 2] - z0) / dz).astype(int), 0, n_cuts - 1)
     Rb = np.where(body_cut, R_body, -np.inf)
     Rlim = np.maximum.reduce([Rb[np.clip(kv + j, 0, n_cuts - 1)] for j in (-1, 0, 1)])
-    top_cut = int(np.nonzero(body_cut)[0].max())
-    handle_v = (rv > Rlim + tol) | (kv > top_cut + 1)
-    handle_v &= ~((kv <= top_cut + 1) & ~np.isfinite(Rlim))  # (a gap in the profile: not handle)
+    first_cut, top_cut = (int(i) for i in np.nonzero(body_cut)[0][[0, -1]])
+    outside = (kv > top_cut + 1) | (kv < first_cut - 1)  # above or below the body
+    # (a gap in the profile between body cuts is not handle)
+    handle_v = outside | (np.isfinite(Rlim) & (rv > Rlim + tol))
     body_v = ~handle_v
     bottom = float(V[body_v, 2].min())
     top = float(V[body_v, 2].max())
@@ -652,16 +661,35 @@ def derive_frame(vertices: np.ndarray, faces: np.ndarray, category: str | None, 
         P, Ns = _samples(V, F, N, area)
         score, c, Rm = _revolution_score(P, Ns)
         aspect = float(np.ptp(V[:, 2]) / (2 * Rm)) if Rm > 0 else np.inf
-        is_container = score >= REVOLUTION_MIN and aspect <= MAX_CONTAINER_ASPECT
+        th = np.linspace(0, np.pi, 90, endpoint=False)
+        proj = V[:, :2] @ np.stack([np.cos(th), np.sin(th)])
+        reach = float((proj.max(0) - proj.min(0)).max() / (2 * Rm)) if Rm > 0 else np.inf
+        is_container = (score >= REVOLUTION_MIN and aspect <= MAX_CONTAINER_ASPECT
+                        and reach <= MAX_CONTAINER_REACH)
         notes.append(f"category not given: {'a container' if is_container else 'a tool'} from the "
-                     f"shape ({100 * score:.0f} % of the side surface is a body of revolution "
-                     f"about a vertical axis, needed {100 * REVOLUTION_MIN:.0f} %; height "
-                     f"{aspect:.1f} diameters, at most {MAX_CONTAINER_ASPECT:g})")
+                     f"shape ({100 * score:.0f} % of the side surface faces one vertical axis, "
+                     f"needed {100 * REVOLUTION_MIN:.0f} %; height {aspect:.1f} diameters, at "
+                     f"most {MAX_CONTAINER_ASPECT:g}; {reach:.1f} diameters across, at most "
+                     f"{MAX_CONTAINER_REACH:g})")
     else:
         is_container = category not in TOOL_CATEGORIES
+    container = None
     if is_container:
-        X_OM, lab, parts, dims, widths, vol, cen, open_wall = _container(V, F, N, area,
-                                                                        category, notes)
+        try:
+            container = _container(V, F, N, area, category, notes)
+        except ModelError:
+            if category is not None:
+                raise
+        if category is None:
+            share = 0.0 if container is None else container[3]["height"] / float(np.ptp(V[:, 2]))
+            if share < MIN_BODY_SHARE:
+                notes.clear()
+                notes.append(f"category not given: a tool from the shape (its body of revolution "
+                             f"spans {100 * share:.0f} % of its height, less than "
+                             f"{100 * MIN_BODY_SHARE:.0f} %: a bowl on a handle)")
+                container = None
+    if container is not None:
+        X_OM, lab, parts, dims, widths, vol, cen, open_wall = container
         kind, cavity_volume, cavity_centroid = "container", vol, cen
     else:
         X_OM, lab, parts, dims, widths = _tool(V, F, N, area, category, notes)
