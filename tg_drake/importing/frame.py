@@ -297,6 +297,15 @@ def _cuts(V, F, N, levels):
     return np.concatenate(pts), np.concatenate(nrm), np.concatenate(cut), area, length
 
 
+def _row_median(A, mask):
+    """Median of each row of A over its masked entries (NaN where a row has none)."""
+    X = np.where(mask, A, np.nan)
+    out = np.full(len(A), np.nan)
+    ok = mask.any(1)
+    out[ok] = np.nanmedian(X[ok], axis=1)
+    return out
+
+
 def _sector_reduce(key, values, n_keys, fn, fill):
     out = np.full(n_keys, fill, float)
     fn.at(out, key, values)
@@ -376,12 +385,11 @@ def _container(V, F, N, area, category, notes):
     if not body_cut.any():
         raise ModelError("no horizontal cut of the mesh goes round a body: is it upright with z "
                          "up?", field="vertices")
-    with np.errstate(all="ignore"):
-        R_body = np.where(body_cut, np.nanmedian(np.where(occupied, rmax, np.nan), axis=1), np.nan)
+    R_body = np.where(body_cut, _row_median(rmax, occupied), np.nan)
     # per-cut spread of the sector maxima (scan noise), robust
     dev = np.abs(rmax - R_body[:, None])
-    with np.errstate(all="ignore"):
-        spread = np.nanmedian(np.where(occupied & body_cut[:, None], dev, np.nan))
+    sel = occupied & body_cut[:, None]
+    spread = float(np.median(dev[sel])) if sel.any() else 0.0
     tol = HANDLE_CLEARANCE + 3 * 1.4826 * (0.0 if not np.isfinite(spread) else float(spread))
 
     # vertices: handle = outside the body's radius profile (neighbouring cuts too) or above it
@@ -446,16 +454,14 @@ def _container(V, F, N, area, category, notes):
     Rmax = float(np.nanmax(R_body))
     dims = {"height": H, "diameter": 2 * Rmax}
     if is_open:
-        with np.errstate(all="ignore"):
-            R_in = np.nanmedian(np.where(in_occ, rin, np.nan), axis=1)
-            nr_key = kc[inward]
-            nr_med = np.array([np.median(-radial[inward][nr_key == k]) if (nr_key == k).any()
-                               else np.nan for k in range(n_cuts)])
+        R_in = _row_median(rin, in_occ)
         lo, hi = levels[cav_idx.min()], levels[cav_idx.max()]
         mid = cav_cut & (levels > lo + 0.3 * (hi - lo)) & (levels < lo + 0.7 * (hi - lo))
         if not mid.any():
             mid = cav_cut
-        wall = float(np.nanmedian((R_body - R_in)[mid] * nr_med[mid]))
+        # across the wall: the radial gap times the cosine of the wall's tilt from vertical
+        tilt_cos = float(np.median(-radial[inward & mid[kc]]))
+        wall = float(np.median((R_body - R_in)[mid])) * tilt_cos
         # base: the inner bottom — upward faces near the axis, else the lowest cut with a cavity
         up = (Ns[:, 2] > 0.9) & (np.linalg.norm(P[:, :2] - c, axis=1) < 0.5 * R_in[cav_idx[0]]) \
             & (P[:, 2] < lo + 0.25 * (hi - lo))
@@ -467,9 +473,9 @@ def _container(V, F, N, area, category, notes):
         crest = _sector_reduce(sec_v, bv[:, 2], SECTORS, np.maximum, -np.inf)
         fill = bottom + float(crest[np.isfinite(crest)].min())
         full = cav_cut & (levels <= fill) & (levels >= bottom + base)
-        with np.errstate(all="ignore"):
-            sq = np.where(in_occ, rin ** 2, np.nan)
-            a_cut = np.pi * np.nanmean(sq, axis=1)  # polar area over the sectors
+        n_in = in_occ.sum(1)
+        # polar area over the sectors
+        a_cut = np.pi * np.where(in_occ, rin, 0.0) ** 2 @ np.ones(SECTORS) / np.maximum(n_in, 1)
         a_cut = np.where(full, np.nan_to_num(a_cut), 0.0)
         vol = float(a_cut.sum() * dz)
         cz = float((a_cut * (levels - bottom)).sum() * dz / vol) if vol > 0 else 0.0
