@@ -19,9 +19,10 @@ Containers (pan, pot, cup, glass, bowl, bottle, can):
   cut belongs to the part above, as in tools/make_objects.py), plus the handle;
 - an inner surface (faces turned towards the axis, not downwards) over at least OPEN_DEPTH of the
   height makes an open vessel: wall = outer − inner radius across the wall, base = height of the
-  inner bottom, cavity = the water filling the inner surface up to the rim's lowest point. A closed body (a bottle or can
-  scanned from outside) has no inner surface: the wall is a prior (WALL_PRIOR) and the cavity the
-  enclosed volume less a shell of that thickness (first order: section area less perimeter × wall).
+  inner bottom, cavity = the water filling the inner surface up to the rim's lowest point. A
+  closed body (a bottle or can scanned from outside) has no inner surface: the wall is a prior
+  (WALL_PRIOR) and the cavity the enclosed volume less a shell of that thickness (first order:
+  section area less perimeter × wall).
 
 Tools (hammer, knife, screwdriver, cooking_tool):
 
@@ -29,7 +30,8 @@ Tools (hammer, knife, screwdriver, cooking_tool):
 - z: the outward normal, reversed, of the convex hull's facet the tool rests on, found among the
   facets its centre of mass (uniform density) projects into, facing within 60° of the surface's
   thinnest principal axis: the one holding the centre of mass lowest. x is the long axis made
-  perpendicular to z; y = z × x; origin at the bottom centre of the bounding box in O;
+  perpendicular to z and turned (within MAX_X_TURN) to the narrowest bounding box; y = z × x;
+  origin at the bottom centre of the bounding box in O;
 - handle versus usable area: the section width (along y) and thickness (along z) profiles along x
   are fitted, as logarithms, by two constant segments; the split is where one profile, next to the
   best step, has gone a fraction of the way from the handle's level to the usable area's. Which
@@ -83,7 +85,8 @@ MIN_CUT_SPACING = 0.0002  # [m] ... at most one per 0.2 mm
 # edge midpoints lie 0.3 % inside its corners) and scan noise, below any handle's thickness.
 HANDLE_CLEARANCE = 0.002
 CUT_TOLERANCE = 5e-4  # [m] a vertex this close below a third's cut belongs to the part above
-COVERAGE = 0.5  # a cut holds the body (or an inner surface) when it has points in this share of sectors
+# a cut holds the body (or an inner surface) when it has points in this share of its sectors
+COVERAGE = 0.5
 OPEN_DEPTH = 0.3  # an inner surface over this share of the height makes an open vessel
 # [m] wall of a closed container seen from outside only: bottles are glass (2.5–3 mm) or PET
 # (0.4–0.5 mm), cans aluminium or tinplate (0.15–0.25 mm); other categories: a ceramic-like 3 mm.
@@ -99,6 +102,7 @@ MAX_CONTAINER_REACH = 3.0
 # body height / overall height: a pan's handle rises above its rim (body 0.67 of it); a ladle
 # standing on its bowl is mostly handle (about 0.1)
 MIN_BODY_SHARE = 0.5
+MAX_X_TURN = 15.0  # [°] search for the narrowest box about the principal axis
 TOOL_BINS = 200  # stations of the section profile along a tool's length
 # Per tool category: which of the two segments is the usable area ("wider" or "narrower" in the
 # profile `channel`: 0 width, 1 thickness), and where the handle ends: where that profile has gone
@@ -585,6 +589,13 @@ def _tool(V, F, N, area, category, notes):
     x = e1 - (e1 @ z) * z
     x /= np.linalg.norm(x)
     y = np.cross(z, x)
+    # x turned in the resting plane, within ±MAX_X_TURN of the principal axis, to the narrowest
+    # bounding box (a knife's offset blade tilts the principal axis off its spine)
+    uv = V @ np.stack([x, y]).T
+    phi = np.radians(np.arange(-MAX_X_TURN, MAX_X_TURN + 1e-9, 0.25))
+    wy = -np.sin(phi)[:, None] * uv[:, 0] + np.cos(phi)[:, None] * uv[:, 1]  # y after turning
+    turn = phi[int(np.argmin(np.ptp(wy, axis=1) + 1e-9 * np.abs(phi)))]
+    x, y = math.cos(turn) * x + math.sin(turn) * y, -math.sin(turn) * x + math.cos(turn) * y
     R = np.stack([x, y, z])
     q = P @ R.T
     qv = V @ R.T
