@@ -87,6 +87,7 @@ HANDLE_CLEARANCE = 0.002
 CUT_TOLERANCE = 5e-4  # [m] a vertex this close below a third's cut belongs to the part above
 # a cut holds the body (or an inner surface) when it has points in this share of its sectors
 COVERAGE = 0.5
+INNER_SHARE = 0.2  # ... and this share of the cut's points face the axis (half do in a vessel)
 OPEN_DEPTH = 0.3  # an inner surface over this share of the height makes an open vessel
 # [m] wall of a closed container seen from outside only: bottles are glass (2.5–3 mm) or PET
 # (0.4–0.5 mm), cans aluminium or tinplate (0.15–0.25 mm); other categories: a ceramic-like 3 mm.
@@ -310,6 +311,22 @@ def _row_median(A, mask):
     return out
 
 
+def _group_median(key, values, n_keys):
+    """Median of `values` per integer key in 0..n_keys−1 (NaN for keys without values)."""
+    out = np.full(n_keys, np.nan)
+    if len(key) == 0:
+        return out
+    order = np.lexsort((values, key))
+    k, v = key[order], values[order]
+    counts = np.bincount(k, minlength=n_keys)
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    has = counts > 0
+    lo = start[has] + (counts[has] - 1) // 2
+    hi = start[has] + counts[has] // 2
+    out[has] = 0.5 * (v[lo] + v[hi])
+    return out
+
+
 def _sector_reduce(key, values, n_keys, fn, fill):
     out = np.full(n_keys, fill, float)
     fn.at(out, key, values)
@@ -394,7 +411,8 @@ def _container(V, F, N, area, category, notes):
     dev = np.abs(rmax - R_body[:, None])
     sel = occupied & body_cut[:, None]
     spread = float(np.median(dev[sel])) if sel.any() else 0.0
-    tol = HANDLE_CLEARANCE + 3 * 1.4826 * (0.0 if not np.isfinite(spread) else float(spread))
+    noise = 3 * 1.4826 * (0.0 if not np.isfinite(spread) else float(spread))  # [m] 3σ
+    tol = HANDLE_CLEARANCE + noise
 
     # vertices: handle = outside the body's radius profile (neighbouring cuts too) or above it
     rv = np.linalg.norm(V[:, :2] - c, axis=1)
@@ -402,7 +420,9 @@ def _container(V, F, N, area, category, notes):
     Rb = np.where(body_cut, R_body, -np.inf)
     Rlim = np.maximum.reduce([Rb[np.clip(kv + j, 0, n_cuts - 1)] for j in (-1, 0, 1)])
     first_cut, top_cut = (int(i) for i in np.nonzero(body_cut)[0][[0, -1]])
-    outside = (kv > top_cut + 1) | (kv < first_cut - 1)  # above or below the body
+    # above or below the body (by more than the noise: a pan's handle rises just above its rim)
+    outside = ((V[:, 2] > levels[top_cut] + dz + noise)
+               | (V[:, 2] < levels[first_cut] - dz - noise))
     # (a gap in the profile between body cuts is not handle)
     handle_v = outside | (np.isfinite(Rlim) & (rv > Rlim + tol))
     body_v = ~handle_v
@@ -448,10 +468,12 @@ def _container(V, F, N, area, category, notes):
 
     # inner surface: faces turned to the axis and not downwards, inside the body's radius
     inward = (radial < 0) & (Nc[:, 2] > -0.2)
-    rin = _sector_reduce(key[inward], r[inward], n_cuts * SECTORS, np.minimum,
-                         np.inf).reshape(n_cuts, SECTORS)
+    rin = _group_median(key[inward], r[inward], n_cuts * SECTORS).reshape(n_cuts, SECTORS)
     in_occ = np.isfinite(rin)
-    cav_cut = (in_occ.mean(1) >= COVERAGE) & body_cut
+    # an inner surface holds a fair share of the cut (not a few stray faces turned inwards)
+    share = np.bincount(kc[inward], minlength=n_cuts) / np.maximum(
+        np.bincount(kc, minlength=n_cuts), 1)
+    cav_cut = (in_occ.mean(1) >= COVERAGE) & body_cut & (share >= INNER_SHARE)
     cav_idx = np.nonzero(cav_cut)[0]
     depth = (cav_idx.max() - cav_idx.min() + 1) * dz if len(cav_idx) else 0.0
     is_open = depth >= OPEN_DEPTH * H
@@ -459,13 +481,19 @@ def _container(V, F, N, area, category, notes):
     dims = {"height": H, "diameter": 2 * Rmax}
     if is_open:
         R_in = _row_median(rin, in_occ)
+        # a sector far off its cut's median (a handle's inner side) takes the median
+        far = np.abs(rin - R_in[:, None]) > np.maximum(0.1 * R_in[:, None], 0.002)
+        rin = np.where(in_occ & far, R_in[:, None], rin)
+        outward = radial > 0.3
+        rout = _group_median(key[outward], r[outward], n_cuts * SECTORS).reshape(n_cuts, SECTORS)
+        R_out = _row_median(rout, np.isfinite(rout))
         lo, hi = levels[cav_idx.min()], levels[cav_idx.max()]
         mid = cav_cut & (levels > lo + 0.3 * (hi - lo)) & (levels < lo + 0.7 * (hi - lo))
         if not mid.any():
             mid = cav_cut
         # across the wall: the radial gap times the cosine of the wall's tilt from vertical
         tilt_cos = float(np.median(-radial[inward & mid[kc]]))
-        wall = float(np.median((R_body - R_in)[mid])) * tilt_cos
+        wall = float(np.nanmedian((R_out - R_in)[mid])) * tilt_cos
         # base: the inner bottom — upward faces near the axis, else the lowest cut with a cavity
         up = (Ns[:, 2] > 0.9) & (np.linalg.norm(P[:, :2] - c, axis=1) < 0.5 * R_in[cav_idx[0]]) \
             & (P[:, 2] < lo + 0.25 * (hi - lo))
