@@ -68,6 +68,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import maximum_filter1d
+from scipy.spatial import cKDTree
 
 from tg_drake.errors import ModelError, unknown_name
 from tg_drake.types import CATEGORIES, PART_LABELS
@@ -97,6 +99,9 @@ REVOLUTION_MIN = 0.5
 # [°] a normal pointing this close at the axis belongs to a body of revolution (a 24-gon's facets
 # are 7.5° off at their edges)
 REVOLUTION_ANGLE = 10.0
+# [m] normals are averaged over this radius for that test: a scan's noise (0.3 mm on 3 mm
+# triangles) tilts single triangles by 10° and more; a 30 mm radius wall turns 8° over it
+NORMAL_RADIUS = 0.004
 MAX_CONTAINER_ASPECT = 6.0  # height / diameter: bottles reach about 4.5, a standing screwdriver 7
 # longest horizontal extent / body diameter: a long-handled saucepan reaches about 2.3, a ladle 4
 MAX_CONTAINER_REACH = 3.0
@@ -365,9 +370,21 @@ def _apply(X, V):
 # Container or tool from the shape
 
 
+def _smoothed_normals(P, N, radius=NORMAL_RADIUS):
+    """Sample normals averaged over the samples within `radius` (a scan's noise tilts each
+    triangle's normal by ten degrees and more)."""
+    pairs = cKDTree(P).query_pairs(radius, output_type="ndarray")
+    S = N.copy()
+    np.add.at(S, pairs[:, 0], N[pairs[:, 1]])
+    np.add.at(S, pairs[:, 1], N[pairs[:, 0]])
+    ln = np.linalg.norm(S, axis=1, keepdims=True)
+    return np.where(ln > 0, S / np.where(ln > 0, ln, 1.0), N)
+
+
 def _revolution_score(P, N):
     """(share of the horizontal-normal surface whose normals point at one vertical axis, within
     REVOLUTION_ANGLE; the axis (x, y); the median radius of those samples [m])."""
+    N = _smoothed_normals(P, N)
     c, dist = _axis_centre(P, N)
     use = np.isfinite(dist)
     if c is None or use.sum() < 10:
@@ -418,7 +435,10 @@ def _container(V, F, N, area, category, notes):
     rv = np.linalg.norm(V[:, :2] - c, axis=1)
     kv = np.clip(((V[:, 2] - z0) / dz).astype(int), 0, n_cuts - 1)
     Rb = np.where(body_cut, R_body, -np.inf)
-    Rlim = np.maximum.reduce([Rb[np.clip(kv + j, 0, n_cuts - 1)] for j in (-1, 0, 1)])
+    # the largest body radius within the noise (and a cut) above or below the vertex: a noisy
+    # flat bottom's cuts catch only patches of it
+    half = 1 + int(math.ceil(noise / dz))
+    Rlim = maximum_filter1d(Rb, size=2 * half + 1, mode="nearest")[kv]
     first_cut, top_cut = (int(i) for i in np.nonzero(body_cut)[0][[0, -1]])
     # above or below the body (by more than the noise: a pan's handle rises just above its rim)
     outside = ((V[:, 2] > levels[top_cut] + dz + noise)
