@@ -69,6 +69,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.ndimage import maximum_filter1d
+from scipy.sparse import coo_matrix
 from scipy.spatial import cKDTree
 
 from tg_drake.errors import ModelError, unknown_name
@@ -99,8 +100,9 @@ REVOLUTION_MIN = 0.5
 # [°] a normal pointing this close at the axis belongs to a body of revolution (a 24-gon's facets
 # are 7.5° off at their edges)
 REVOLUTION_ANGLE = 10.0
-# [m] normals are averaged over this radius for that test: a scan's noise (0.3 mm on 3 mm
-# triangles) tilts single triangles by 10° and more; a 30 mm radius wall turns 8° over it
+# [m] normals are averaged over this radius (or 2.5 sample spacings) for that test: a scan's
+# noise (0.3 mm on 3 mm triangles) tilts single triangles by 10° and more; a 30 mm radius wall
+# turns 8° over it
 NORMAL_RADIUS = 0.004
 MAX_CONTAINER_ASPECT = 6.0  # height / diameter: bottles reach about 4.5, a standing screwdriver 7
 # longest horizontal extent / body diameter: a long-handled saucepan reaches about 2.3, a ladle 4
@@ -370,21 +372,21 @@ def _apply(X, V):
 # Container or tool from the shape
 
 
-def _smoothed_normals(P, N, radius=NORMAL_RADIUS):
+def _smoothed_normals(P, N, radius):
     """Sample normals averaged over the samples within `radius` (a scan's noise tilts each
     triangle's normal by ten degrees and more)."""
     pairs = cKDTree(P).query_pairs(radius, output_type="ndarray")
-    S = N.copy()
-    np.add.at(S, pairs[:, 0], N[pairs[:, 1]])
-    np.add.at(S, pairs[:, 1], N[pairs[:, 0]])
+    i, j = np.concatenate([pairs[:, 0], pairs[:, 1]]), np.concatenate([pairs[:, 1], pairs[:, 0]])
+    A = coo_matrix((np.ones(len(i)), (i, j)), shape=(len(P), len(P))).tocsr()
+    S = N + A @ N
     ln = np.linalg.norm(S, axis=1, keepdims=True)
     return np.where(ln > 0, S / np.where(ln > 0, ln, 1.0), N)
 
 
-def _revolution_score(P, N):
+def _revolution_score(P, N, area_total):
     """(share of the horizontal-normal surface whose normals point at one vertical axis, within
     REVOLUTION_ANGLE; the axis (x, y); the median radius of those samples [m])."""
-    N = _smoothed_normals(P, N)
+    N = _smoothed_normals(P, N, max(NORMAL_RADIUS, 2.5 * math.sqrt(area_total / len(P))))
     c, dist = _axis_centre(P, N)
     use = np.isfinite(dist)
     if c is None or use.sum() < 10:
@@ -724,7 +726,7 @@ def derive_frame(vertices: np.ndarray, faces: np.ndarray, category: str | None, 
     notes: list[str] = []
     if category is None:
         P, Ns = _samples(V, F, N, area)
-        score, c, Rm = _revolution_score(P, Ns)
+        score, c, Rm = _revolution_score(P, Ns, float(area.sum()))
         aspect = float(np.ptp(V[:, 2]) / (2 * Rm)) if Rm > 0 else np.inf
         th = np.linspace(0, np.pi, 90, endpoint=False)
         proj = V[:, :2] @ np.stack([np.cos(th), np.sin(th)])
