@@ -43,7 +43,8 @@ Tools (hammer, knife, screwdriver, cooking_tool):
   - screwdriver: the shaft and tip — the narrower segment, from halfway down the width's step (the
     handle's tapered nose is handle);
   - cooking_tool: the spatula head or the ladle bowl — the wider segment, from a quarter of the
-    way up the width's step (a narrowing neck is handle);
+    way up the width's step, or from the narrowest section of a neck before it (a handle
+    narrowing by NECK_NARROWING or more): the neck is handle;
   - unknown category: the segment less like a hand grip (section further from GRIP_SECTION in
     log width + log thickness), from halfway along the larger step; said in the notes.
 
@@ -119,13 +120,17 @@ TOOL_RULES = {
     # the head: wider; it begins where the section has widened a quarter of the way
     "hammer": ("wider", 0, 0.25, "the head is the wider segment"),
     # the blade: thinner; it begins where the handle starts thinning (the bolster is the blade's)
-    "knife": ("narrower", 1, 0.2, "the blade is the thinner segment, from where the handle thins"),
+    "knife": ("narrower", 1, 0.1, "the blade is the thinner segment, from where the handle thins"),
     # the shaft and tip: narrower; the handle's tapered nose is still handle
     "screwdriver": ("narrower", 0, 0.5, "the shaft and tip are the narrower segment"),
     # the spatula head or ladle bowl: wider, from where the section has widened a quarter of the
     # way (a narrowing neck is handle)
     "cooking_tool": ("wider", 0, 0.25, "the head or bowl is the wider segment"),
 }
+# a cooking tool's neck: a section this much narrower than the handle's median, within this share
+# of the length before the head
+NECK_NARROWING = 0.8
+NECK_SEARCH = 0.15
 GRIP_SECTION = (0.025, 0.02)  # [m] width, thickness of a typical hand grip (unknown category)
 TUKEY_C = 4.685  # Tukey biweight constant (95 % efficiency under Gaussian noise)
 
@@ -689,6 +694,17 @@ def _tool(V, F, N, area, category, notes):
         split = float(xc[j] + t * (xc[j + 1] - xc[j]))
     else:
         split = float(edges[k])
+    if category == "cooking_tool":
+        # a neck (the handle narrowing before the head) is handle up to its narrowest section
+        side = (xc < split) if usable_high else (xc > split)
+        near = side & (np.abs(xc - split) < NECK_SEARCH * (x1 - x0))
+        if near.any():
+            j = int(np.flatnonzero(near)[np.argmin(S[near, ch])])
+            if S[j, ch] < h_lvl + math.log(NECK_NARROWING):
+                # a bin reports its widest section: the narrowest lies up to a bin further on
+                step = edges[1] - edges[0]
+                split = float(edges[j + 1] + step if usable_high else edges[j] - step)
+                rule += "; the neck is handle up to its narrowest section"
     if not usable_high:
         R = np.stack([-x, -y, z])
         qv = V @ R.T
