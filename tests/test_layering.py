@@ -40,9 +40,10 @@ FORBIDDEN_IN_CORES = (
 )
 
 
-# Libraries imported inside functions anywhere: optional extras (ray, grakel) and the slow ones
-# used for one output (matplotlib for pictures, tqdm for a progress bar).
-OPTIONAL_OR_SLOW = ("ray", "grakel", "matplotlib", "tqdm")
+# Libraries imported inside functions anywhere: optional extras (ray, grakel), the slow ones
+# used for one output (matplotlib for pictures, tqdm for a progress bar) and the object import
+# (trimesh, a convex decomposition), which only a scenario's `mesh:` entries need.
+OPTIONAL_OR_SLOW = ("ray", "grakel", "matplotlib", "tqdm", "tg_drake.importing")
 
 
 @dataclass(frozen=True)
@@ -116,7 +117,7 @@ def misplaced_local_imports(imports: list[Import], command_modules) -> list[Impo
     """Imports inside functions that neither a command module's start-up nor an optional or slow
     library explains."""
     return [i for i in imports if i.local and i.source not in command_modules
-            and i.target.split(".")[0] not in OPTIONAL_OR_SLOW]
+            and not any(_within(i.target, m) for m in OPTIONAL_OR_SLOW)]
 
 
 def unit_of(module: str, package: str, depth: int) -> str | None:

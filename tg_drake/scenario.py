@@ -2,14 +2,18 @@
 
 A scenario has the shape of Drake's hardware_sim `Scenario` (model directives, `plant_config`,
 `cameras`, `model_drivers`) plus our own blocks: `objects` (library objects placed on the table) and
-`task` (target, task, placement, ground truth). Files are loaded with
+`task` (target, task, placement, ground truth), and `object_libraries` (user object library folders
+whose objects `objects` may name). Files are loaded with
 `pydrake.common.yaml.yaml_load_typed`: unknown keys are errors, missing keys keep their defaults.
 A file may hold one scenario at its root or several named entries (YAML anchors make variants:
 `MugFull: {<<: *Mug, ...}`); `load_scenario(filename, scenario_name=...)` picks one.
 
 Frames: W is the world, with its origin at the iiwa base on the floor plate and z up; the table top
 frame T has its origin at the centre of the table-top surface, z up. Objects are placed by their
-library id, a pose label, a position on the table (in T) and a yaw about the table normal.
+library id (or a mesh file or model folder, imported through `tg_drake.importing` and cached), a
+pose label (or `resting: auto | K`, the K-th most probable stable pose), a position on the table
+(in T) and a yaw about the table normal. Relative paths (`mesh`, `labels`, `object_libraries`)
+resolve against the scenario file's folder; `package://tg_drake_models/...` works too.
 """
 
 
@@ -29,11 +33,12 @@ from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.sensors import CameraConfig
 from scipy.spatial import ConvexHull
 
-from tg_drake.errors import RuleError, ScenarioError, unknown_name
+from tg_drake.errors import ModelError, RuleError, ScenarioError, unknown_name
 from tg_drake.kernels.database import SOURCES as KERNEL_SOURCES
 from tg_drake.kernels.database import KernelPriorConfig
 from tg_drake.logic.engine import LogicQueryConfig
-from tg_drake.objects import get_object, mesh
+from tg_drake.models import models_root
+from tg_drake.objects import add_library, get_object, mesh, register_object
 from tg_drake.perception.config import PerceptionConfig
 from tg_drake.planning.planner import PlannerConfig
 from tg_drake.robot import WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
@@ -129,16 +134,38 @@ def default_plant_config() -> MultibodyPlantConfig:
                                 discrete_contact_approximation="sap")
 
 
+# A `mesh:` entry's import settings (tg_drake.importing.ImportOptions).
+UNITS = ("auto", "m", "cm", "mm", "inch")
+UP_AXES = ("z", "y", "x")
+COLLISION_BACKENDS = ("coacd", "vhacd")
+MESH_FIELDS = ("category", "units", "up_axis", "mass", "density", "labels", "collision")
+
+
 @dataclass
 class ObjectPlacement:
-    """A library object on the table."""
+    """An object on the table: a library object (`id`) or a mesh to import (`mesh`), exactly
+    one of them."""
 
-    id: str = ""  # object library id (`tg-drake objects` lists them)
+    id: str = ""  # object library id (`tg-drake objects` lists them); set to the imported
+    # object's id for a `mesh` entry once the scenario is validated
     name: str = ""  # model instance name in the plant; defaults to the id
     pose: str = "upright"  # one of POSES suited to the object (library.yaml lists them)
     xy: list[float] = field(default_factory=lambda: [0.0, 0.0])  # position in the table frame [m]
     yaw: float = 0.0  # rotation about the table normal [deg]
     containment: str = "empty"  # "empty" or "full"; full adds the contents' mass (water)
+    resting: int | str | None = None  # instead of pose: "auto" (the most probable stable pose)
+    # or K (the K-th most probable, 0 first), for objects whose library lists stable poses
+    mesh: str = ""  # a mesh file (OBJ STL PLY GLB DAE), a model folder (Google Scanned Objects,
+    # YCB) or a one-body SDF/URDF to import: a path relative to the scenario file, or package://
+    category: str = ""  # mesh entries: the true category (ground truth for evaluation only;
+    # perception never reads it); "" = the importer decides
+    units: str = "auto"  # mesh entries: one of UNITS; auto infers them from the size
+    up_axis: str = "z"  # mesh entries: the mesh's up axis, one of UP_AXES
+    mass: float | None = None  # mesh entries: [kg]; with neither mass nor density, a density
+    density: float | None = None  # prior of the category [kg/m³]
+    labels: str = ""  # mesh entries: a per-vertex part label file (.npy) of the mesh
+    collision: str = ""  # mesh entries: convex decomposition, one of COLLISION_BACKENDS; "" = the
+    # importer's default
 
     @property
     def instance_name(self) -> str:
@@ -317,6 +344,8 @@ class Scenario:
     model_drivers: dict[str, DriverConfig] = field(default_factory=default_drivers)
     cameras: dict[str, CameraConfig] = field(default_factory=default_cameras)
     objects: list[ObjectPlacement] = field(default_factory=list)
+    object_libraries: list[str] = field(default_factory=list)  # user library folders (relative
+    # to the scenario file) whose objects `objects` may name
     task: TaskConfig = field(default_factory=TaskConfig)
     pipeline: PipelineConfig = field(default_factory=PipelineConfig)
     # The table: its top's size (x, y) [m] and where its top frame T sits in the world. The station
@@ -364,7 +393,8 @@ def load_scenario(filename: "str | Path | None" = None, *, scenario_name: str | 
             scenario = yaml_load_typed(schema=Scenario, data=scenario_text, defaults=scenario)
     except (RuntimeError, ValueError, TypeError, KeyError, AssertionError, yaml.YAMLError) as e:
         raise ScenarioError(_tidy_yaml_error(str(e)), file=where) from None
-    validate(scenario, where=where)
+    validate(scenario, where=where,
+             base_dir=Path(filename).parent if filename is not None else None)
     return scenario
 
 
@@ -395,6 +425,26 @@ def _check_raw(file_text: str | None, scenario_name: str | None, scenario_text: 
         except SchemaError as e:
             raise ScenarioError(e.message, file=where if text is file_text else "<text>",
                                 field=e.path) from None
+        _check_raw_objects(doc, where if text is file_text else "<text>")
+
+
+def _check_raw_objects(doc, where: str) -> None:
+    """`id` or `mesh` and `pose` or `resting`, as written (the loaded dataclass has defaults)."""
+    objects = doc.get("objects") if isinstance(doc, dict) else None
+    for i, entry in enumerate(objects if isinstance(objects, list) else []):
+        if not isinstance(entry, dict):
+            continue
+        given = {k for k, v in entry.items() if v not in (None, "")}  # a dump writes defaults
+        if ("id" in given) == ("mesh" in given):
+            raise ScenarioError(
+                ("both `id` and `mesh` are given" if "id" in given else "neither `id` nor `mesh` "
+                 "is given") + "; an object is either `{id: ID, ...}` (a library object, see "
+                 "`tg-drake objects`) or `{mesh: FILE_OR_FOLDER, ...}` (imported)",
+                file=where, field=f"objects[{i}]")
+        if "pose" in given and "resting" in given:
+            raise ScenarioError("give either `pose` (upright, sideways, upsidedown) or "
+                                "`resting` (auto or K), not both", file=where,
+                                field=f"objects[{i}].resting")
 
 
 def scenario_names(filename: str | Path) -> list[str]:
@@ -413,23 +463,25 @@ def _tidy_yaml_error(message: str) -> str:
     return message if len(message) <= MAX_MESSAGE else message[:MAX_MESSAGE] + "…"
 
 
-def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
-    """Checks names and geometry that YAML typing alone cannot."""
+def validate(scenario: Scenario, *, where: str = "<scenario>",
+             base_dir: str | Path | None = None) -> None:
+    """Checks names and geometry that YAML typing alone cannot. First resolves the scenario's
+    objects (`resolve_objects`: user libraries registered, mesh entries imported, paths made
+    absolute against `base_dir`, the current folder when None)."""
     names = set()
     problem = table_size_problem(scenario.table_size)
     if problem:
         raise ScenarioError(problem, file=where, field="table_size")
+    resolve_objects(scenario, where=where, base_dir=base_dir)
     half = np.asarray(scenario.table_size) / 2
     for i, placement in enumerate(scenario.objects):
         f = f"objects[{i}]"
-        if not placement.id:
-            raise ScenarioError("an object needs an `id` (see `tg-drake objects`)", file=where,
-                                field=f + ".id")
-
         try:
             obj = get_object(placement.id)
         except ScenarioError as e:
             raise ScenarioError(e.message, file=where, field=f + ".id") from None
+        if placement.resting is not None:
+            _resolve_resting(placement, obj, where, f)
         if placement.pose not in POSES:
             raise unknown_name("pose", placement.pose, POSES, error=ScenarioError, file=where,
                                field=f + ".pose")
@@ -490,6 +542,147 @@ def validate(scenario: Scenario, *, where: str = "<scenario>") -> None:
         _validate_geometry(scenario)
     except ScenarioError as e:
         raise ScenarioError(e.message, file=where, field=e.field) from None
+
+
+def _resolve_path(text: str, base_dir: Path | None) -> Path:
+    """A scenario's path: package://tg_drake_models/... in the shipped models, else relative to
+    `base_dir` (the scenario file's folder; the current folder when None)."""
+    if text.startswith("package://"):
+        package, _, rest = text[len("package://"):].partition("/")
+        if package != MODELS_PACKAGE:
+            raise ScenarioError(f"unknown package {package!r} in {text!r}; allowed: "
+                                f"{MODELS_PACKAGE}")
+        return Path(models_root()) / rest
+    path = Path(text).expanduser()
+    if not path.is_absolute():
+        path = (Path(base_dir) if base_dir is not None else Path.cwd()) / path
+    return path.resolve()
+
+
+MODELS_PACKAGE = "tg_drake_models"
+
+
+def resolve_objects(scenario: Scenario, *, where: str = "<scenario>",
+                    base_dir: str | Path | None = None) -> None:
+    """Makes the scenario's objects known to `tg_drake.objects.get_object`: registers its
+    `object_libraries` and imports its `mesh` entries (cached by content: a second call imports
+    nothing), setting each mesh entry's `id` to the imported object's. Paths are made absolute
+    (against `base_dir`, else the current folder), so that calling it again anywhere — the station
+    does — gives the same objects."""
+    scenario.object_libraries[:] = add_object_libraries(scenario.object_libraries, where=where,
+                                                        base_dir=base_dir)
+    for i, placement in enumerate(scenario.objects):
+        f = f"objects[{i}]"
+        if not placement.mesh:
+            if not placement.id:
+                raise ScenarioError("an object needs an `id` (see `tg-drake objects`) or a "
+                                    "`mesh` to import", file=where, field=f + ".id")
+            given = [k for k in MESH_FIELDS
+                     if getattr(placement, k) != getattr(_DEFAULT_PLACEMENT, k)]
+            if given:
+                raise ScenarioError(f"{', '.join(given)} apply to `mesh` entries only; a library "
+                                    "object's come from its library", file=where,
+                                    field=f"{f}.{given[0]}")
+            continue
+        _check_mesh_entry(placement, where, f)
+        try:
+            path = _resolve_path(placement.mesh, base_dir)
+            labels = _resolve_path(placement.labels, base_dir) if placement.labels else None
+        except ScenarioError as e:
+            raise ScenarioError(e.message, file=where, field=f + ".mesh") from None
+        if not path.exists():
+            raise ScenarioError(f"no such mesh file or model folder {str(path)!r}", file=where,
+                                field=f + ".mesh")
+        if labels is not None and not labels.is_file():
+            raise ScenarioError(f"no such part label file {str(labels)!r}", file=where,
+                                field=f + ".labels")
+        placement.mesh = str(path)
+        if labels is not None:
+            placement.labels = str(labels)
+        obj = _import_mesh(placement, path, labels, where, f)
+        if placement.id and placement.id != obj.id:
+            raise ScenarioError(f"both `id` ({placement.id!r}) and `mesh` are given; an object is "
+                                "either `{id: ID, ...}` or `{mesh: FILE_OR_FOLDER, ...}`",
+                                file=where, field=f)
+        placement.id = obj.id
+
+
+_DEFAULT_PLACEMENT = ObjectPlacement()
+
+
+def add_object_libraries(folders, *, where: str = "<scenario>", base_dir: str | Path | None = None,
+                         field: str = "object_libraries") -> list[str]:
+    """Registers user object libraries (`tg_drake.objects.add_library`) named by paths relative to
+    `base_dir` (or package://); returns their absolute paths. ScenarioError naming `field`[i]."""
+    out = []
+    for i, text in enumerate(folders):
+        try:
+            path = _resolve_path(text, base_dir)
+            add_library(path)
+        except (ScenarioError, ModelError) as e:
+            raise ScenarioError(e.message + (f" ({e.file})" if e.file else ""), file=where,
+                                field=f"{field}[{i}]") from None
+        out.append(str(path))
+    return out
+
+
+def _check_mesh_entry(placement: ObjectPlacement, where: str, f: str) -> None:
+    for name, allowed in (("units", UNITS), ("up_axis", UP_AXES)):
+        if getattr(placement, name) not in allowed:
+            raise unknown_name(name.replace("_", " "), getattr(placement, name), allowed,
+                               error=ScenarioError, file=where, field=f"{f}.{name}")
+    if placement.category and placement.category not in CATEGORIES:
+        raise unknown_name("category", placement.category, CATEGORIES, error=ScenarioError,
+                           file=where, field=f + ".category")
+    if placement.collision and placement.collision not in COLLISION_BACKENDS:
+        raise unknown_name("collision backend", placement.collision, COLLISION_BACKENDS,
+                           error=ScenarioError, file=where, field=f + ".collision")
+    if placement.mass is not None and placement.density is not None:
+        raise ScenarioError("give `mass` or `density`, not both", file=where,
+                            field=f + ".density")
+    for name, unit in (("mass", "kg"), ("density", "kg/m³")):
+        value = getattr(placement, name)
+        if value is not None and not (_finite(value) and value > 0):
+            raise ScenarioError(f"must be a finite number > 0 [{unit}], got {value}",
+                                file=where, field=f"{f}.{name}")
+
+
+def _import_mesh(placement: ObjectPlacement, path: Path, labels: Path | None, where: str,
+                 f: str):
+    """The object imported from `path` (tg_drake.importing, cached), registered."""
+    from tg_drake.importing import ImportOptions, import_cached  # the import is heavy and rare
+
+    options = dict(category=placement.category or None, units=placement.units,
+                   up_axis=placement.up_axis, mass=placement.mass, density=placement.density,
+                   labels=labels)
+    if placement.collision:
+        options["collision"] = placement.collision
+    try:
+        return register_object(import_cached(path, ImportOptions(**options)))
+    except (ScenarioError, ModelError) as e:
+        field = e.field if e.field in MESH_FIELDS else "mesh"
+        raise ScenarioError(e.message + (f" ({e.file})" if e.file else ""), file=where,
+                            field=f"{f}.{field}") from None
+
+
+def _resolve_resting(placement: ObjectPlacement, obj, where: str, f: str) -> None:
+    """`resting: auto | K` → the pose label of the object's K-th most probable stable pose."""
+    k = 0 if placement.resting == "auto" else placement.resting
+    if isinstance(k, str):
+        try:
+            k = int(k)
+        except ValueError:
+            raise ScenarioError(f"resting must be auto or a whole number K >= 0, got {k!r}",
+                                file=where, field=f + ".resting") from None
+    try:
+        stable = obj.stable_pose(k)
+    except ScenarioError as e:
+        raise ScenarioError(e.message, file=where, field=f + ".resting") from None
+    if stable.pose not in obj.poses:
+        raise ScenarioError(f"{obj.id}'s stable pose {k} is none of its poses "
+                            f"({', '.join(obj.poses)}); choose another K", file=where,
+                            field=f + ".resting")
+    placement.pose = stable.pose
 
 
 # Drake's names (MultibodyPlantConfig): contact models, discrete approximations, surfaces.

@@ -146,7 +146,11 @@ def check_document(value, schema, path: str = "") -> None:
                 raise SchemaError(f"unknown alternative !{tag}{hint}; allowed: "
                                   + ", ".join(f"!{n}" for n in names), where)
             return check_document(value, structs[names.index(tag)], path)
-        return  # unions of scalars: left to the loader
+        if isinstance(value, (dict, list)) and all(m in (int, float, str, bool)
+                                                   for m in non_null):
+            raise SchemaError("expected a single value (" + " or ".join(
+                _type_name(m) for m in non_null) + f"), got {_quote(value)}", where)
+        return  # unions of scalars: the rest is left to the loader
     origin = typing.get_origin(schema)
     args = typing.get_args(schema)
     if origin is list:

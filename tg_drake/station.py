@@ -72,6 +72,7 @@ from tg_drake.scenario import (
     ObjectPlacement,
     Scenario,
     WsgPdDriver,
+    resolve_objects,
 )
 from tg_drake.table import add_table
 
@@ -153,7 +154,9 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser
                  ) -> dict[str, ModelInstanceIndex]:
     if not scenario.objects:
         return {}
-
+    # User libraries and mesh entries (a validated scenario's paths are absolute; the import is
+    # cached): get_object then knows every object, in this process too.
+    resolve_objects(scenario)
     directives = [ModelDirective(add_model=AddModel(
         name=p.instance_name, file=get_object(p.id).sdf_url)) for p in scenario.objects]
     added = ProcessModelDirectives(ModelDirectives(directives=directives), parser)

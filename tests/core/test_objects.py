@@ -24,7 +24,7 @@ from tg_drake.objects import (
 from tg_drake.robot import WSG_MAX_OPENING, WSG_PAD_SIZE
 from tg_drake.types import CATEGORIES, PART_LABELS
 
-LIB = load_library()
+LIB = load_library()  # the shipped, generated library: user libraries need not meet these rules
 IDS = list(LIB)
 TOOLS = ("hammer", "knife", "screwdriver", "cooking_tool")
 OPEN = ("pan", "pot", "cup", "glass", "bowl")

@@ -123,3 +123,34 @@ def test_bad_sampling_settings_are_named(tmp_path, generator, message):
                            f"generator: {generator}\n")
     with pytest.raises(ScenarioError, match=message):
         load_suite(path)
+
+
+def test_suites_may_name_objects_of_user_libraries(tmp_path):
+    from library_helpers import copy_object
+
+    from tg_drake.evaluation.jobs import run_case
+    from tg_drake.objects import forget_registered
+
+    copy_object("cup_01", "my_mug", tmp_path / "lib")
+    try:
+        path = write(tmp_path, "kind: synthetic\ndataset: syn\nground_truth: ground_truth.yaml\n"
+                               "object_libraries: [lib]\ngenerator: {objects: [my_mug]}\n")
+        suite, cases = load_suite(path)
+        assert suite.object_libraries == [str((tmp_path / "lib").resolve())]
+        assert {c.target_placement.id for c in cases} == {"my_mug"}
+        assert cases[0].object_libraries == tuple(suite.object_libraries)
+        assert cases[0].truth.category == "cup"
+        forget_registered()  # as in a fresh worker: the case registers its libraries itself
+        record = run_case(cases[0])
+        assert record["object"] == "my_mug" and set(record["priors"]) == {"label_fractions",
+                                                                           "manifolds"}
+        path = write(tmp_path, "kind: executed\ndataset: robot\nobject_libraries: [lib]\n"
+                               "scenes:\n  - name: a\n    objects: [{id: my_mug, resting: 1}]\n"
+                               "    task: {task: pass, ground_truth: {tasks: [pass], "
+                               "parts: [middle], reason: x}}\n", name="scenes.yaml")
+        _, cases = load_suite(path)
+        placement = cases[0].target_placement
+        assert (placement.id, placement.pose, placement.resting) == ("my_mug", "sideways", 1)
+        assert cases[0].truth.category == "cup"
+    finally:
+        forget_registered()

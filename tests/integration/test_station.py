@@ -85,3 +85,30 @@ def test_depth_image_shows_an_object_on_the_table():
     distance = np.linalg.norm(X_WC.translation() - [0.75, 0.0, 0.06])
     radius = get_object("can_02").dimensions["diameter"] / 2
     assert np.median(depths[1][closer]) == pytest.approx(distance, abs=2 * radius)
+
+
+def test_an_object_of_a_user_library_loads_through_its_file_url(tmp_path):
+    from library_helpers import copy_object
+
+    from tg_drake.objects import forget_registered
+    from tg_drake.scenario import ObjectPlacement
+
+    copy_object("can_02", "my_can", tmp_path / "lib")
+    try:
+        scenario = Scenario(object_libraries=[str(tmp_path / "lib")],
+                            objects=[ObjectPlacement(id="my_can", containment="full")])
+        diagram, st = make_station(scenario)
+        body = st.object_body("my_can")
+        context = diagram.CreateDefaultContext()
+        plant_context = st.plant.GetMyContextFromRoot(context)
+        # the user library's SDF (file://) with its mesh beside it: the can's mass, resting upright
+        from tg_drake.objects import get_object
+        obj = get_object("my_can")
+        assert obj.sdf_url.startswith("file:///")
+        assert body.default_mass() == pytest.approx(obj.mass, rel=1e-6)
+        X_WO = st.plant.EvalBodyPoseInWorld(plant_context, body)
+        assert X_WO.translation()[2] == pytest.approx(
+            scenario.X_WT.GetDeterministicValue().translation()[2], abs=1e-6)
+        assert len(st.objects) == 1
+    finally:
+        forget_registered()

@@ -32,7 +32,15 @@ from tg_drake.objects import get_object, mesh
 from tg_drake.perception.ground_truth import interior_visible
 from tg_drake.perception.render import perceive
 from tg_drake.run import run_scenario
-from tg_drake.scenario import DgiScorer, LocalOnly, PipelineConfig, Scenario, TaskConfig, validate
+from tg_drake.scenario import (
+    DgiScorer,
+    LocalOnly,
+    PipelineConfig,
+    Scenario,
+    TaskConfig,
+    resolve_objects,
+    validate,
+)
 from tg_drake.types import CATEGORIES
 
 # Logic methods (the paper's columns, the paper's two ablations and ours): name → (category/task
@@ -190,7 +198,8 @@ def run_executed(case) -> dict:
     pipeline.logic.use_prior = case.variant != "pipeline_uniform"
     scenario = Scenario(objects=list(case.objects), pipeline=pipeline,
                         task=TaskConfig(target=case.target, task=case.task,
-                                        place_xy=list(case.place_xy)))
+                                        place_xy=list(case.place_xy)),
+                        object_libraries=list(case.object_libraries))
     validate(scenario, where=case.key)
     result = run_scenario(scenario, scenario_path=case.key)
     keep = ("perception", "category_prior", "category", "task", "part", "grasp",
@@ -200,6 +209,10 @@ def run_executed(case) -> dict:
 
 def run_case(case) -> dict | list[dict]:
     """Runs one case of any kind (the sweep's job function)."""
+    # A worker process starts with the shipped library only: register the case's user libraries
+    # and imported objects (paths absolute since the suite was loaded; imports are cached).
+    resolve_objects(Scenario(objects=list(case.objects),
+                             object_libraries=list(case.object_libraries)), where=case.key)
     if case.kind == "synthetic":
         return run_synthetic(case)
     if case.kind == "perceived":

@@ -34,7 +34,13 @@ from pydrake.common.yaml import yaml_load_typed
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.objects import get_object, load_library
-from tg_drake.scenario import ObjectPlacement, Scenario, TaskConfig, validate
+from tg_drake.scenario import (
+    ObjectPlacement,
+    Scenario,
+    TaskConfig,
+    add_object_libraries,
+    validate,
+)
 from tg_drake.types import CATEGORIES, CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 KINDS = ("synthetic", "perceived", "executed")
@@ -132,6 +138,8 @@ class Suite:
     generator: Generator | None = None
     scenes: list[Scene] = field(default_factory=list)
     seed: int = 0  # seeds the kernel prior's samplings
+    object_libraries: list[str] = field(default_factory=list)  # user object library folders
+    # (relative to the suite file) whose objects the generator and the scenes may name
 
 
 @dataclass(frozen=True)
@@ -160,6 +168,7 @@ class Case:
     kernel_T: int = 13
     seed: int = 0
     theory: str = "specific"  # the model variant standing in for "specific" (PLM, pipeline)
+    object_libraries: tuple[str, ...] = ()  # absolute folders of the user libraries it names
 
     @property
     def target_placement(self) -> ObjectPlacement:
@@ -281,7 +290,9 @@ def _can_hold_water(obj, pose: str) -> bool:
 
 def _generated(suite: Suite, gt: GroundTruthTables, where: str, gt_where: str) -> list[Case]:
     g = suite.generator
-    library = load_library()
+    library = dict(load_library())
+    for folder in suite.object_libraries:  # registered (and checked) by load_suite
+        library.update(load_library(folder))
     chosen = []
     for name in g.objects:
         if name == "all":
@@ -343,7 +354,8 @@ def _generated(suite: Suite, gt: GroundTruthTables, where: str, gt_where: str) -
                             cases.append(Case(
                                 key, suite.name, suite.kind, suite.dataset, (placement,),
                                 placement.instance_name, task, tuple(g.place_xy), truth,
-                                variant, tuple(suite.settings), suite.kernel_T, suite.seed))
+                                variant, tuple(suite.settings), suite.kernel_T, suite.seed,
+                                object_libraries=tuple(suite.object_libraries)))
     return _drawn(suite, cases, library) if g.sample else cases
 
 
@@ -385,9 +397,8 @@ def _scenes(suite: Suite, where: str) -> list[Case]:
         if not scene.name:
             raise ScenarioError("a scene needs a `name`", file=where, field=f + ".name")
         for j, variation in enumerate(scene.variations or [Variation()]):
-            objects = [ObjectPlacement(
-                id=p.id, name=p.name, pose=p.pose, containment=p.containment,
-                xy=[p.xy[0] + variation.shift[0], p.xy[1] + variation.shift[1]],
+            objects = [dataclasses.replace(
+                p, xy=[p.xy[0] + variation.shift[0], p.xy[1] + variation.shift[1]],
                 yaw=p.yaw + variation.yaw) for p in scene.objects]
             task = TaskConfig(target=variation.target or scene.task.target,
                               task=variation.task or scene.task.task,
@@ -397,9 +408,10 @@ def _scenes(suite: Suite, where: str) -> list[Case]:
                 if part not in PART_LABELS:  # named by the suite's field, before the scenario's
                     raise unknown_name("part", part, PART_LABELS, error=ScenarioError,
                                        file=where, field=f + ".task.ground_truth.parts")
-            scenario = Scenario(objects=objects, task=task)
-            try:
-                validate(scenario, where=where)
+            scenario = Scenario(objects=objects, task=task,
+                                object_libraries=list(suite.object_libraries))
+            try:  # mesh entries are imported here (cached), relative to the suite's folder
+                validate(scenario, where=where, base_dir=Path(where).parent)
             except ScenarioError as e:
                 raise ScenarioError(e.message, file=where,
                                     field=f"{f}.variations[{j}] {e.field or ''}".strip()) from None
@@ -416,7 +428,8 @@ def _scenes(suite: Suite, where: str) -> list[Case]:
                 key = f"{suite.name}/{scene.name}_{j:02d}" + (f"@{variant}" if variant else "")
                 cases.append(Case(key, suite.name, suite.kind, suite.dataset, tuple(objects),
                                   target.instance_name, task.task, tuple(task.place_xy), truth,
-                                  variant, tuple(suite.settings), suite.kernel_T, suite.seed))
+                                  variant, tuple(suite.settings), suite.kernel_T, suite.seed,
+                                  object_libraries=tuple(suite.object_libraries)))
     return cases
 
 
@@ -449,6 +462,8 @@ def load_suite(path: "str | Path") -> "tuple[Suite, list[Case]]":
     if not 0 <= suite.kernel_T <= 15:
         raise ScenarioError(f"kernel_T must lie in 0..15, got {suite.kernel_T}", file=where,
                             field="kernel_T")
+    suite.object_libraries = add_object_libraries(suite.object_libraries, where=where,
+                                                  base_dir=path.parent)
     if (suite.generator is None) == (not suite.scenes):
         raise ScenarioError("a suite has either a `generator` or `scenes`, not "
                             + ("both" if suite.scenes else "neither"), file=where)

@@ -204,15 +204,13 @@ class KernelDatabase:
         """The category prior of one cloud: the n most similar graphs weighted by exp(−rank).
 
         `entries` picks the graphs compared with ("all", "ground_truth", "perceived"; None: the
-        database's default). `exclude_object` leaves every graph of that library object out
-        (leave-one-object-out).
+        database's default). `exclude_object` leaves every graph of that object out
+        (leave-one-object-out); an object the database does not hold (one imported after it was
+        built) leaves nothing out.
         """
         mask = self.entry_mask(entries)
         sim = np.where(mask, self.similarities(points, normals, labels, t=t), -np.inf)
         if exclude_object is not None:
-            if exclude_object not in set(self.object_ids.tolist()):
-                raise unknown_name("database object", exclude_object,
-                                   sorted(set(self.object_ids.tolist())), error=KernelError)
             sim = np.where(self.object_ids == exclude_object, -np.inf, sim)
         priors, neighbours = category_priors(sim, self.categories, n_neighbours=n_neighbours)
         return CategoryDistribution(

@@ -1,0 +1,185 @@
+"""Scenario objects beyond the shipped library: object_libraries, mesh entries, resting: auto | K."""
+
+from __future__ import annotations
+
+import sys
+import types
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from library_helpers import copy_object
+
+from tg_drake.errors import ModelError, ScenarioError
+from tg_drake.objects import forget_registered, get_object, load_library
+from tg_drake.scenario import load_scenario
+
+
+@pytest.fixture(autouse=True)
+def _clean_registry():
+    forget_registered()
+    yield
+    forget_registered()
+
+
+def _write(folder: Path, text: str) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / "s.yaml"
+    path.write_text(text)
+    return path
+
+
+def test_object_libraries_resolve_against_the_scenario_folder(tmp_path, monkeypatch):
+    copy_object("cup_01", "my_mug", tmp_path / "scenes" / "lib")
+    path = _write(tmp_path / "scenes", "object_libraries: [lib]\n"
+                                       "objects: [{id: my_mug, xy: [0, 0.05], yaw: 30}]\n")
+    monkeypatch.chdir(tmp_path)  # not the scenario's folder
+    scenario = load_scenario(path)
+    assert scenario.object_libraries == [str((tmp_path / "scenes" / "lib").resolve())]
+    assert get_object("my_mug").root == (tmp_path / "scenes" / "lib").resolve()
+    assert scenario.target_placement().id == "my_mug"
+
+
+def test_object_libraries_errors_name_the_entry(tmp_path):
+    path = _write(tmp_path, "object_libraries: [nowhere]\nobjects: [{id: cup_01}]\n")
+    with pytest.raises(ScenarioError, match="no such object library folder") as e:
+        load_scenario(path)
+    assert e.value.field == "object_libraries[0]"
+    copy_object("cup_01", "cup_01", tmp_path / "lib")
+    path = _write(tmp_path, "object_libraries: [lib]\nobjects: [{id: cup_01}]\n")
+    with pytest.raises(ScenarioError, match="'cup_01' is in both the shipped library and") as e:
+        load_scenario(path)
+    assert e.value.field == "object_libraries[0]"
+    path = _write(tmp_path, "object_libraries: [package://elsewhere/lib]\nobjects: [{id: cup_01}]\n")
+    with pytest.raises(ScenarioError, match="unknown package 'elsewhere'.*allowed: tg_drake_models"):
+        load_scenario(path)
+
+
+def test_the_shipped_library_through_package_url(tmp_path):
+    # Registering the shipped folder as a user library is an id clash with itself only if the
+    # folders differ: they do not, so it is accepted and changes nothing.
+    path = _write(tmp_path, "object_libraries: [package://tg_drake_models/objects]\n"
+                            "objects: [{id: cup_01}]\n")
+    assert load_scenario(path).target_placement().id == "cup_01"
+
+
+@pytest.mark.parametrize("entry, field, message", [
+    ("{id: cup_01, mesh: m.obj}", "objects[0]", "both `id` and `mesh` are given; an object is "
+                                                "either `{id: ID, ...}`"),
+    ("{name: x}", "objects[0]", "neither `id` nor `mesh` is given"),
+    ("{id: cup_01, pose: upright, resting: auto}", "objects[0].resting",
+     "give either `pose` (upright, sideways, upsidedown) or `resting`"),
+    ("{id: cup_01, category: cup}", "objects[0].category", "apply to `mesh` entries only"),
+    ("{mesh: m.obj, units: furlong}", "objects[0].units",
+     "unknown units 'furlong'; allowed: auto, m, cm, mm, inch"),
+    ("{mesh: m.obj, up_axis: w}", "objects[0].up_axis", "unknown up axis 'w'; allowed: z, y, x"),
+    ("{mesh: m.obj, category: mug}", "objects[0].category", "unknown category 'mug'; allowed: pan"),
+    ("{mesh: m.obj, collision: hull}", "objects[0].collision",
+     "unknown collision backend 'hull'; allowed: coacd, vhacd"),
+    ("{mesh: m.obj, mass: 0.3, density: 900}", "objects[0].density", "give `mass` or `density`"),
+    ("{mesh: m.obj, mass: -0.3}", "objects[0].mass", "must be a finite number > 0 [kg]"),
+    ("{mesh: m.obj, mass: heavy}", "objects[0].mass", "expected a number, got 'heavy'"),
+    ("{mesh: absent.obj}", "objects[0].mesh", "no such mesh file or model folder"),
+    ("{mesh: m.obj, labels: absent.npy}", "objects[0].labels", "no such part label file"),
+    ("{id: cup_01, resting: auto}", "objects[0].resting",
+     "cup_01 lists no stable poses; give a `pose` among upright, sideways, upsidedown"),
+    ("{id: cup_01, resting: [1]}", "objects[0].resting", "expected a single value (int or str)"),
+    ("{id: cup_01, resting: two}", "objects[0].resting", "resting must be auto or a whole number"),
+])
+def test_mesh_and_resting_mistakes_name_the_field(tmp_path, entry, field, message):
+    (tmp_path / "m.obj").write_text("v 0 0 0\n")  # never imported: the checks come first
+    path = _write(tmp_path, f"objects:\n  - {entry}\n")
+    with pytest.raises(ScenarioError) as e:
+        load_scenario(path)
+    assert e.value.field == field
+    assert message in str(e.value)
+    assert str(path) in str(e.value)
+
+
+def test_resting_k_picks_the_kth_most_probable_stable_pose(tmp_path):
+    copy_object("cup_01", "my_mug", tmp_path / "lib")
+    names = list(load_library(tmp_path / "lib")["my_mug"].poses)
+    for resting, pose in (("auto", names[0]), ("0", names[0]), ("1", names[1])):
+        path = _write(tmp_path, f"object_libraries: [lib]\n"
+                                f"objects: [{{id: my_mug, resting: {resting}}}]\n")
+        placement = load_scenario(path).objects[0]
+        assert placement.pose == pose
+    path = _write(tmp_path, "object_libraries: [lib]\nobjects: [{id: my_mug, resting: 9}]\n")
+    with pytest.raises(ScenarioError, match=r"my_mug has no stable pose 9; allowed: 0 \(upright, "
+                                            r"p=0.50\), 1 \(") as e:
+        load_scenario(path)
+    assert e.value.field == "objects[0].resting"
+
+
+@dataclass(frozen=True)
+class _FakeOptions:
+    category: str | None = None
+    obj_id: str | None = None
+    units: str = "auto"
+    up_axis: str = "z"
+    mass: float | None = None
+    density: float | None = None
+    labels: Path | None = None
+    collision: str = "coacd"
+
+
+@pytest.fixture
+def fake_importer(tmp_path, monkeypatch):
+    """tg_drake.importing stood in for by one that 'imports' a shipped cup into a library."""
+    calls = []
+
+    def import_cached(source, options, *, cache_root=None):
+        calls.append((Path(source), options))
+        if options.units == "inch":
+            raise ModelError("the mesh is 30 m across", file=str(source), field="units")
+        lib = tmp_path / "cache"
+        if not (lib / "blue_mug").is_dir():
+            copy_object("cup_01", "blue_mug", lib, category=options.category or "cup")
+        return load_library(lib)["blue_mug"]
+
+    module = types.ModuleType("tg_drake.importing")
+    module.ImportOptions, module.import_cached = _FakeOptions, import_cached
+    monkeypatch.setitem(sys.modules, "tg_drake.importing", module)
+    return calls
+
+
+def test_a_mesh_entry_becomes_a_registered_object(tmp_path, fake_importer):
+    (tmp_path / "scenes" / "mugs").mkdir(parents=True)
+    (tmp_path / "scenes" / "mugs" / "blue_mug.obj").write_text("v 0 0 0\n")
+    path = _write(tmp_path / "scenes",
+                  "objects:\n  - {mesh: mugs/blue_mug.obj, category: cup, units: mm, up_axis: y,"
+                  " mass: 0.35, collision: vhacd, xy: [0, 0.05], yaw: 30, name: mine,"
+                  " resting: 1}\n  - {id: can_02, xy: [0.2, -0.2]}\n")
+    scenario = load_scenario(path)
+    placement = scenario.objects[0]
+    assert placement.id == "blue_mug" and placement.instance_name == "mine"
+    assert placement.mesh == str((tmp_path / "scenes" / "mugs" / "blue_mug.obj").resolve())
+    assert placement.pose == list(get_object("blue_mug").poses)[1]
+    source, options = fake_importer[0]
+    assert source == Path(placement.mesh)
+    assert (options.category, options.units, options.up_axis, options.mass, options.density,
+            options.collision) == ("cup", "mm", "y", 0.35, None, "vhacd")
+    # the resolved scenario validates again (the station resolves it again) to the same object
+    from tg_drake.scenario import validate
+    validate(scenario)
+    assert scenario.objects[0].id == "blue_mug" and len(fake_importer) == 2
+
+
+def test_import_errors_name_the_entry_and_field(tmp_path, fake_importer):
+    (tmp_path / "m.obj").write_text("v 0 0 0\n")
+    path = _write(tmp_path, "objects: [{mesh: m.obj, units: inch}]\n")
+    with pytest.raises(ScenarioError, match="30 m across") as e:
+        load_scenario(path)
+    assert e.value.field == "objects[0].units"
+
+
+def test_a_dumped_scenario_loads_again(tmp_path):
+    from pydrake.common.yaml import yaml_dump_typed
+
+    from tg_drake.scenario import Scenario
+    copy_object("cup_01", "my_mug", tmp_path / "lib")
+    path = _write(tmp_path, "object_libraries: [lib]\nobjects: [{id: my_mug, xy: [0, 0.1]}]\n")
+    text = yaml_dump_typed(load_scenario(path), schema=Scenario)
+    again = _write(tmp_path / "again", text)
+    scenario = load_scenario(again)  # every default written out: pose with resting null, ...
+    assert scenario.objects[0].id == "my_mug" and scenario.objects[0].xy == [0, 0.1]
