@@ -28,6 +28,8 @@ FIGURES: dict[str, str] = {
     "dgi_us_per_hypothesis": "tg_drake.grasping.bench:dgi_us_per_hypothesis",
     "sweep_efficiency": "tg_drake.evaluation.bench:sweep_efficiency",
     "pipeline_rtf": "tg_drake.run:bench_pipeline_rtf",
+    "import_s": "tg_drake.importing.bench:import_s",
+    "scan_run_ratio": "tg_drake.run:bench_scan_run_ratio",
 }
 
 

@@ -187,3 +187,45 @@ def bench_pipeline_rtf():
     return Figure(median=ours, unit="simulated s / wall s",
                   reference="explicit InverseDynamicsController, 2 ms step, same scenario",
                   reference_median=reference, speedup=ours / reference)
+
+
+def bench_scan_run_ratio():
+    """`scan_run_ratio`: wall seconds of one whole run (build included, as `tg-drake run`) of the
+    default scenario with its cup replaced by the scan-like cup (a `mesh:` entry, already imported:
+    the cache's second run), over the same run with the library's cup, median of 3 each. Issue 18's
+    goal: ≤ 1.3. `median` is the ratio; the reference is the library cup's run [s]."""
+    import os
+    import statistics
+    import tempfile
+
+    from tg_drake.bench import Figure
+    from tg_drake.importing.bench import write_scan_cup
+    from tg_drake.scenario import ObjectPlacement, Scenario, TaskConfig, resolve_objects
+
+    def seconds(placement: ObjectPlacement) -> float:
+        # scenarios/default.yaml: the paper's Fig. 1 cup, upright and empty, to be passed.
+        scenario = Scenario(objects=[placement], task=TaskConfig(task="pass", place_xy=[0.0, -0.3]))
+        resolve_objects(scenario)
+        t0 = time.perf_counter()
+        run_scenario(scenario, scenario_path="bench")
+        return time.perf_counter() - t0
+
+    with tempfile.TemporaryDirectory(prefix="tg_drake_bench_scan_") as tmp:
+        old = os.environ.get("TG_DRAKE_CACHE")
+        os.environ["TG_DRAKE_CACHE"] = str(Path(tmp) / "cache")
+        try:
+            mesh = str(write_scan_cup(Path(tmp)))
+            scan = ObjectPlacement(mesh=mesh, category="cup", up_axis="y", pose="upright",
+                                   name="cup")
+            resolve_objects(Scenario(objects=[dataclasses.replace(scan)]))  # the import, untimed
+            scan_s = statistics.median(seconds(dataclasses.replace(scan)) for _ in range(3))
+            library_s = statistics.median(
+                seconds(ObjectPlacement(id="cup_01", pose="upright")) for _ in range(3))
+        finally:
+            if old is None:
+                os.environ.pop("TG_DRAKE_CACHE", None)
+            else:
+                os.environ["TG_DRAKE_CACHE"] = old
+    return Figure(median=scan_s / library_s, unit="ratio (scan-like run s / library run s)",
+                  reference="the same run with the library's cup_01 [s]",
+                  reference_median=library_s, speedup=library_s / scan_s)
