@@ -113,7 +113,7 @@ class LibraryObject:
     poses: dict  # pose name → RestingPose, for the poses that suit the object.
     n_vertices: int
     n_triangles: int
-    root: Path = None  # the library folder (its library.yaml and <id>/); the shipped library's
+    root: Path | None = None  # the library folder (library.yaml and <id>/); the shipped one's
     # when None
     labels_source: str = "generated"  # an entry of LABEL_SOURCES: how the part labels were made
     stable_poses: tuple = ()  # StablePose, most probable first; empty when the library lists none

@@ -1,4 +1,4 @@
-"""Scenario objects beyond the shipped library: object_libraries, mesh entries, resting: auto | K."""
+"""Scenario objects beyond the shipped library: object_libraries, mesh entries, resting."""
 
 from __future__ import annotations
 
@@ -50,8 +50,10 @@ def test_object_libraries_errors_name_the_entry(tmp_path):
     with pytest.raises(ScenarioError, match="'cup_01' is in both the shipped library and") as e:
         load_scenario(path)
     assert e.value.field == "object_libraries[0]"
-    path = _write(tmp_path, "object_libraries: [package://elsewhere/lib]\nobjects: [{id: cup_01}]\n")
-    with pytest.raises(ScenarioError, match="unknown package 'elsewhere'.*allowed: tg_drake_models"):
+    path = _write(tmp_path, "object_libraries: [package://elsewhere/lib]\n"
+                            "objects: [{id: cup_01}]\n")
+    with pytest.raises(ScenarioError, match="unknown package 'elsewhere'.*allowed: "
+                                            "tg_drake_models"):
         load_scenario(path)
 
 
