@@ -240,13 +240,20 @@ def _object(obj_id: str, d: dict, root: Path | None = None) -> LibraryObject:
 def load_library(path: str | Path | None = None) -> MappingProxyType:
     """Object id → LibraryObject of one library, in its order (the shipped one, by category then
     instance, when `path` is None; else the library folder `path` or its library.yaml). Cached
-    per folder; does not register a user library (`add_library` does)."""
+    per folder and library.yaml version (a library written again is read again); does not
+    register a user library (`add_library` does)."""
     if path is None:
         return _load_shipped()
     root = Path(path).expanduser()
     if root.name == "library.yaml":
         root = root.parent
-    return _load_folder(root.resolve())
+    root = root.resolve()
+    try:
+        st = (root / "library.yaml").stat()
+        version = (st.st_mtime_ns, st.st_size)
+    except OSError:
+        version = None  # _load_folder says what is missing
+    return _load_folder(root, version)
 
 
 @functools.cache
@@ -269,7 +276,7 @@ def _load_shipped() -> MappingProxyType:
 
 
 @functools.cache
-def _load_folder(root: Path) -> MappingProxyType:
+def _load_folder(root: Path, version) -> MappingProxyType:
     """A user library; ModelError naming library.yaml and the field for a malformed one."""
     path = root / "library.yaml"
     if not root.is_dir():

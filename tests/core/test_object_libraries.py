@@ -151,3 +151,11 @@ def test_objects_command_lists_a_user_library(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "my_knife" in out and "my_mug" not in out and "1 objects" in out
     yaml.safe_load((tmp_path / "library.yaml").read_text())  # still valid YAML
+
+
+def test_a_library_written_again_is_read_again(tmp_path):
+    copy_object("cup_01", "first", tmp_path)
+    assert list(load_library(tmp_path)) == ["first"]
+    assert load_library(tmp_path) is load_library(tmp_path / "library.yaml")  # cached
+    copy_object("knife_01", "second", tmp_path)  # an import merged into the same folder
+    assert list(load_library(tmp_path)) == ["first", "second"]
