@@ -38,7 +38,7 @@ from tg_drake.kernels.database import SOURCES as KERNEL_SOURCES
 from tg_drake.kernels.database import KernelPriorConfig
 from tg_drake.logic.engine import LogicQueryConfig
 from tg_drake.models import models_root
-from tg_drake.objects import add_library, get_object, mesh, register_object
+from tg_drake.objects import PACKAGE, add_library, get_object, mesh, register_object
 from tg_drake.perception.config import PerceptionConfig
 from tg_drake.planning.planner import PlannerConfig
 from tg_drake.robot import WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
@@ -549,17 +549,14 @@ def _resolve_path(text: str, base_dir: Path | None) -> Path:
     `base_dir` (the scenario file's folder; the current folder when None)."""
     if text.startswith("package://"):
         package, _, rest = text[len("package://"):].partition("/")
-        if package != MODELS_PACKAGE:
+        if package != PACKAGE:
             raise ScenarioError(f"unknown package {package!r} in {text!r}; allowed: "
-                                f"{MODELS_PACKAGE}")
+                                f"{PACKAGE}")
         return Path(models_root()) / rest
     path = Path(text).expanduser()
     if not path.is_absolute():
         path = (Path(base_dir) if base_dir is not None else Path.cwd()) / path
     return path.resolve()
-
-
-MODELS_PACKAGE = "tg_drake_models"
 
 
 def resolve_objects(scenario: Scenario, *, where: str = "<scenario>",
