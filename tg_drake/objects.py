@@ -352,11 +352,11 @@ def _check_clash(obj: LibraryObject) -> None:
 
 def add_library(path: str | Path) -> MappingProxyType:
     """Registers the user library at folder `path` (get_object then finds its objects) and returns
-    its objects. Registering it again does nothing; an id another library holds is a ModelError
-    naming both libraries."""
+    its objects. Registering it again does nothing unless its library.yaml changed (then its
+    objects are read again); an id another library holds is a ModelError naming both libraries."""
     lib = load_library(path)
     root = next(iter(lib.values())).root if lib else Path(path).expanduser().resolve()
-    if root in _LIBRARIES:
+    if _LIBRARIES.get(root) is lib:
         return lib
     for obj in lib.values():
         _check_clash(obj)

@@ -663,8 +663,12 @@ def _import_mesh(placement: ObjectPlacement, path: Path, labels: Path | None, wh
 
 
 def _resolve_resting(placement: ObjectPlacement, obj, where: str, f: str) -> None:
-    """`resting: auto | K` → the pose label of the object's K-th most probable stable pose."""
-    k = 0 if placement.resting == "auto" else placement.resting
+    """`resting: auto | K` → the pose label of the object's K-th most probable stable pose (auto:
+    the most probable one that is one of its poses; a tilted pose has no label downstream)."""
+    k = placement.resting
+    if k == "auto":
+        named = [j for j, s in enumerate(obj.stable_poses) if s.pose in obj.poses]
+        k = named[0] if named else 0
     if isinstance(k, str):
         try:
             k = int(k)
@@ -676,9 +680,10 @@ def _resolve_resting(placement: ObjectPlacement, obj, where: str, f: str) -> Non
     except ScenarioError as e:
         raise ScenarioError(e.message, file=where, field=f + ".resting") from None
     if stable.pose not in obj.poses:
+        usable = [str(j) for j, s in enumerate(obj.stable_poses) if s.pose in obj.poses]
         raise ScenarioError(f"{obj.id}'s stable pose {k} is none of its poses "
-                            f"({', '.join(obj.poses)}); choose another K", file=where,
-                            field=f + ".resting")
+                            f"({', '.join(obj.poses)}); allowed: auto, {', '.join(usable)}",
+                            file=where, field=f + ".resting")
     placement.pose = stable.pose
 
 
