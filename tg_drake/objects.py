@@ -313,8 +313,6 @@ def _load_folder(root: Path, version) -> MappingProxyType:
         if o.labels_source not in LABEL_SOURCES:
             raise unknown_name("label source", o.labels_source, LABEL_SOURCES,
                                error=ModelError, file=str(path), field=f"{field}.labels")
-        if not o.sdf_path.is_file():
-            raise ModelError(f"{o.id}'s SDF is missing", file=str(o.sdf_path))
         objects[o.id] = o
     return MappingProxyType(objects)
 
@@ -359,6 +357,9 @@ def add_library(path: str | Path) -> MappingProxyType:
     if _LIBRARIES.get(root) is lib:
         return lib
     for obj in lib.values():
+        if not obj.sdf_path.is_file():
+            raise ModelError(f"{obj.id}'s SDF is missing (the library lists it; its folder "
+                             "holds no model)", file=str(obj.sdf_path))
         _check_clash(obj)
     _LIBRARIES[root] = lib
     return lib

@@ -159,3 +159,12 @@ def test_a_library_written_again_is_read_again(tmp_path):
     assert load_library(tmp_path) is load_library(tmp_path / "library.yaml")  # cached
     copy_object("knife_01", "second", tmp_path)  # an import merged into the same folder
     assert list(load_library(tmp_path)) == ["first", "second"]
+
+
+def test_registering_a_library_whose_object_has_no_files_names_the_sdf(tmp_path):
+    copy_object("cup_01", "gone", tmp_path)
+    (tmp_path / "gone" / "gone.sdf").unlink()
+    assert "gone" in load_library(tmp_path)  # listed (tg-drake objects shows it)
+    with pytest.raises(ModelError, match="gone's SDF is missing") as e:
+        add_library(tmp_path)
+    assert e.value.file.endswith("gone.sdf")
