@@ -95,7 +95,8 @@ class LibraryObject:
     """One object of the library (fields as in library.yaml; SI units)."""
 
     id: str
-    category: str  # an entry of CATEGORIES.
+    category: str | None  # an entry of CATEGORIES; None for an object imported without one
+    # (its true category unknown: ground truth only, perception never reads it)
     material: str  # main material (the body; for a tool, its usable area).
     density: float  # [kg/m³] mass / volume (the material's density when the object has one).
     part_materials: dict  # part name → material, for parts of another material.
@@ -307,7 +308,7 @@ def _load_folder(root: Path, version) -> MappingProxyType:
             o = _object(str(obj_id), d, root)
         except (KeyError, TypeError, ValueError, IndexError, AttributeError) as e:
             raise ModelError(f"malformed entry: {e}", file=str(path), field=field) from None
-        if o.category not in CATEGORIES:
+        if o.category is not None and o.category not in CATEGORIES:
             raise unknown_name("category", o.category, CATEGORIES, error=ModelError,
                                file=str(path), field=f"{field}.category")
         if o.labels_source not in LABEL_SOURCES:
@@ -509,7 +510,7 @@ def main(args) -> int:
           f"{'mass [kg]':>9s}  parts")
     for o in objs:
         size = "×".join(f"{100 * e:.1f}" for e in o.extents)
-        print(f"{o.id:16s} {o.category:12s} {o.material:10s} {size:18s} {o.mass:9.3f}  "
+        print(f"{o.id:16s} {o.category or '-':12s} {o.material:10s} {size:18s} {o.mass:9.3f}  "
               f"{', '.join(o.parts)}")
     print(f"{len(objs)} objects")
     return 0

@@ -168,3 +168,11 @@ def test_registering_a_library_whose_object_has_no_files_names_the_sdf(tmp_path)
     with pytest.raises(ModelError, match="gone's SDF is missing") as e:
         add_library(tmp_path)
     assert e.value.file.endswith("gone.sdf")
+
+
+def test_an_object_imported_without_a_category_has_none(tmp_path, capsys):
+    copy_object("bowl_01", "thing", tmp_path, category=None)
+    obj = load_library(tmp_path)["thing"]
+    assert obj.category is None and obj.is_container
+    assert main(Namespace(json=False, category=None, library=str(tmp_path))) == 0
+    assert "thing            -  " in capsys.readouterr().out
