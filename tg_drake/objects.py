@@ -95,7 +95,8 @@ class LibraryObject:
     """One object of the library (fields as in library.yaml; SI units)."""
 
     id: str
-    category: str  # an entry of CATEGORIES.
+    category: str | None  # an entry of CATEGORIES; None for an object imported without one
+    # (its true category unknown: ground truth only, perception never reads it)
     material: str  # main material (the body; for a tool, its usable area).
     density: float  # [kg/m³] mass / volume (the material's density when the object has one).
     part_materials: dict  # part name → material, for parts of another material.
@@ -113,7 +114,7 @@ class LibraryObject:
     poses: dict  # pose name → RestingPose, for the poses that suit the object.
     n_vertices: int
     n_triangles: int
-    root: Path = None  # the library folder (its library.yaml and <id>/); the shipped library's
+    root: Path | None = None  # the library folder (library.yaml and <id>/); the shipped one's
     # when None
     labels_source: str = "generated"  # an entry of LABEL_SOURCES: how the part labels were made
     stable_poses: tuple = ()  # StablePose, most probable first; empty when the library lists none
@@ -240,13 +241,20 @@ def _object(obj_id: str, d: dict, root: Path | None = None) -> LibraryObject:
 def load_library(path: str | Path | None = None) -> MappingProxyType:
     """Object id → LibraryObject of one library, in its order (the shipped one, by category then
     instance, when `path` is None; else the library folder `path` or its library.yaml). Cached
-    per folder; does not register a user library (`add_library` does)."""
+    per folder and library.yaml version (a library written again is read again); does not
+    register a user library (`add_library` does)."""
     if path is None:
         return _load_shipped()
     root = Path(path).expanduser()
     if root.name == "library.yaml":
         root = root.parent
-    return _load_folder(root.resolve())
+    root = root.resolve()
+    try:
+        st = (root / "library.yaml").stat()
+        version = (st.st_mtime_ns, st.st_size)
+    except OSError:
+        version = None  # _load_folder says what is missing
+    return _load_folder(root, version)
 
 
 @functools.cache
@@ -269,7 +277,7 @@ def _load_shipped() -> MappingProxyType:
 
 
 @functools.cache
-def _load_folder(root: Path) -> MappingProxyType:
+def _load_folder(root: Path, version) -> MappingProxyType:
     """A user library; ModelError naming library.yaml and the field for a malformed one."""
     path = root / "library.yaml"
     if not root.is_dir():
@@ -300,14 +308,12 @@ def _load_folder(root: Path) -> MappingProxyType:
             o = _object(str(obj_id), d, root)
         except (KeyError, TypeError, ValueError, IndexError, AttributeError) as e:
             raise ModelError(f"malformed entry: {e}", file=str(path), field=field) from None
-        if o.category not in CATEGORIES:
+        if o.category is not None and o.category not in CATEGORIES:
             raise unknown_name("category", o.category, CATEGORIES, error=ModelError,
                                file=str(path), field=f"{field}.category")
         if o.labels_source not in LABEL_SOURCES:
             raise unknown_name("label source", o.labels_source, LABEL_SOURCES,
                                error=ModelError, file=str(path), field=f"{field}.labels")
-        if not o.sdf_path.is_file():
-            raise ModelError(f"{o.id}'s SDF is missing", file=str(o.sdf_path))
         objects[o.id] = o
     return MappingProxyType(objects)
 
@@ -345,13 +351,16 @@ def _check_clash(obj: LibraryObject) -> None:
 
 def add_library(path: str | Path) -> MappingProxyType:
     """Registers the user library at folder `path` (get_object then finds its objects) and returns
-    its objects. Registering it again does nothing; an id another library holds is a ModelError
-    naming both libraries."""
+    its objects. Registering it again does nothing unless its library.yaml changed (then its
+    objects are read again); an id another library holds is a ModelError naming both libraries."""
     lib = load_library(path)
     root = next(iter(lib.values())).root if lib else Path(path).expanduser().resolve()
-    if root in _LIBRARIES:
+    if _LIBRARIES.get(root) is lib:
         return lib
     for obj in lib.values():
+        if not obj.sdf_path.is_file():
+            raise ModelError(f"{obj.id}'s SDF is missing (the library lists it; its folder "
+                             "holds no model)", file=str(obj.sdf_path))
         _check_clash(obj)
     _LIBRARIES[root] = lib
     return lib
@@ -501,7 +510,7 @@ def main(args) -> int:
           f"{'mass [kg]':>9s}  parts")
     for o in objs:
         size = "×".join(f"{100 * e:.1f}" for e in o.extents)
-        print(f"{o.id:16s} {o.category:12s} {o.material:10s} {size:18s} {o.mass:9.3f}  "
+        print(f"{o.id:16s} {o.category or '-':12s} {o.material:10s} {size:18s} {o.mass:9.3f}  "
               f"{', '.join(o.parts)}")
     print(f"{len(objs)} objects")
     return 0

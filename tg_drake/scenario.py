@@ -38,7 +38,7 @@ from tg_drake.kernels.database import SOURCES as KERNEL_SOURCES
 from tg_drake.kernels.database import KernelPriorConfig
 from tg_drake.logic.engine import LogicQueryConfig
 from tg_drake.models import models_root
-from tg_drake.objects import add_library, get_object, mesh, register_object
+from tg_drake.objects import PACKAGE, add_library, get_object, mesh, register_object
 from tg_drake.perception.config import PerceptionConfig
 from tg_drake.planning.planner import PlannerConfig
 from tg_drake.robot import WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
@@ -549,17 +549,14 @@ def _resolve_path(text: str, base_dir: Path | None) -> Path:
     `base_dir` (the scenario file's folder; the current folder when None)."""
     if text.startswith("package://"):
         package, _, rest = text[len("package://"):].partition("/")
-        if package != MODELS_PACKAGE:
+        if package != PACKAGE:
             raise ScenarioError(f"unknown package {package!r} in {text!r}; allowed: "
-                                f"{MODELS_PACKAGE}")
+                                f"{PACKAGE}")
         return Path(models_root()) / rest
     path = Path(text).expanduser()
     if not path.is_absolute():
         path = (Path(base_dir) if base_dir is not None else Path.cwd()) / path
     return path.resolve()
-
-
-MODELS_PACKAGE = "tg_drake_models"
 
 
 def resolve_objects(scenario: Scenario, *, where: str = "<scenario>",
@@ -666,8 +663,12 @@ def _import_mesh(placement: ObjectPlacement, path: Path, labels: Path | None, wh
 
 
 def _resolve_resting(placement: ObjectPlacement, obj, where: str, f: str) -> None:
-    """`resting: auto | K` → the pose label of the object's K-th most probable stable pose."""
-    k = 0 if placement.resting == "auto" else placement.resting
+    """`resting: auto | K` → the pose label of the object's K-th most probable stable pose (auto:
+    the most probable one that is one of its poses; a tilted pose has no label downstream)."""
+    k = placement.resting
+    if k == "auto":
+        named = [j for j, s in enumerate(obj.stable_poses) if s.pose in obj.poses]
+        k = named[0] if named else 0
     if isinstance(k, str):
         try:
             k = int(k)
@@ -679,9 +680,10 @@ def _resolve_resting(placement: ObjectPlacement, obj, where: str, f: str) -> Non
     except ScenarioError as e:
         raise ScenarioError(e.message, file=where, field=f + ".resting") from None
     if stable.pose not in obj.poses:
+        usable = [str(j) for j, s in enumerate(obj.stable_poses) if s.pose in obj.poses]
         raise ScenarioError(f"{obj.id}'s stable pose {k} is none of its poses "
-                            f"({', '.join(obj.poses)}); choose another K", file=where,
-                            field=f + ".resting")
+                            f"({', '.join(obj.poses)}); allowed: auto, {', '.join(usable)}",
+                            file=where, field=f + ".resting")
     placement.pose = stable.pose
 
 

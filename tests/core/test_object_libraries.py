@@ -151,3 +151,28 @@ def test_objects_command_lists_a_user_library(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "my_knife" in out and "my_mug" not in out and "1 objects" in out
     yaml.safe_load((tmp_path / "library.yaml").read_text())  # still valid YAML
+
+
+def test_a_library_written_again_is_read_again(tmp_path):
+    copy_object("cup_01", "first", tmp_path)
+    assert list(load_library(tmp_path)) == ["first"]
+    assert load_library(tmp_path) is load_library(tmp_path / "library.yaml")  # cached
+    copy_object("knife_01", "second", tmp_path)  # an import merged into the same folder
+    assert list(load_library(tmp_path)) == ["first", "second"]
+
+
+def test_registering_a_library_whose_object_has_no_files_names_the_sdf(tmp_path):
+    copy_object("cup_01", "gone", tmp_path)
+    (tmp_path / "gone" / "gone.sdf").unlink()
+    assert "gone" in load_library(tmp_path)  # listed (tg-drake objects shows it)
+    with pytest.raises(ModelError, match="gone's SDF is missing") as e:
+        add_library(tmp_path)
+    assert e.value.file.endswith("gone.sdf")
+
+
+def test_an_object_imported_without_a_category_has_none(tmp_path, capsys):
+    copy_object("bowl_01", "thing", tmp_path, category=None)
+    obj = load_library(tmp_path)["thing"]
+    assert obj.category is None and obj.is_container
+    assert main(Namespace(json=False, category=None, library=str(tmp_path))) == 0
+    assert "thing            -  " in capsys.readouterr().out

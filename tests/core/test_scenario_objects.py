@@ -1,4 +1,4 @@
-"""Scenario objects beyond the shipped library: object_libraries, mesh entries, resting: auto | K."""
+"""Scenario objects beyond the shipped library: object_libraries, mesh entries, resting."""
 
 from __future__ import annotations
 
@@ -50,8 +50,10 @@ def test_object_libraries_errors_name_the_entry(tmp_path):
     with pytest.raises(ScenarioError, match="'cup_01' is in both the shipped library and") as e:
         load_scenario(path)
     assert e.value.field == "object_libraries[0]"
-    path = _write(tmp_path, "object_libraries: [package://elsewhere/lib]\nobjects: [{id: cup_01}]\n")
-    with pytest.raises(ScenarioError, match="unknown package 'elsewhere'.*allowed: tg_drake_models"):
+    path = _write(tmp_path, "object_libraries: [package://elsewhere/lib]\n"
+                            "objects: [{id: cup_01}]\n")
+    with pytest.raises(ScenarioError, match="unknown package 'elsewhere'.*allowed: "
+                                            "tg_drake_models"):
         load_scenario(path)
 
 
@@ -104,11 +106,28 @@ def test_resting_k_picks_the_kth_most_probable_stable_pose(tmp_path):
                                 f"objects: [{{id: my_mug, resting: {resting}}}]\n")
         placement = load_scenario(path).objects[0]
         assert placement.pose == pose
+    # A tilted stable pose (no name) first: auto takes the most probable named one, K = 0 fails.
+    stable = [dict(pose=None, probability=0.6, xyz=[0, 0, 0.03], rpy=[0.5, 0, 0],
+                   support_margin=0.001)] + [
+        dict(pose=p, probability=0.1, support_margin=0.01, **{k: list(v) for k, v in (
+            ("xyz", r.xyz), ("rpy", r.rpy))}) for p, r in get_object_poses(tmp_path)]
+    copy_object("cup_01", "tilted_mug", tmp_path / "lib", stable_poses=stable)
+    path = _write(tmp_path, "object_libraries: [lib]\nobjects: [{id: tilted_mug, resting: auto}]\n")
+    assert load_scenario(path).objects[0].pose == names[0]
+    path = _write(tmp_path, "object_libraries: [lib]\nobjects: [{id: tilted_mug, resting: 0}]\n")
+    with pytest.raises(ScenarioError, match=r"tilted_mug's stable pose 0 is none of its poses "
+                                            r"\(upright, sideways, upsidedown\); allowed: auto, 1, "
+                                            r"2, 3"):
+        load_scenario(path)
     path = _write(tmp_path, "object_libraries: [lib]\nobjects: [{id: my_mug, resting: 9}]\n")
     with pytest.raises(ScenarioError, match=r"my_mug has no stable pose 9; allowed: 0 \(upright, "
                                             r"p=0.50\), 1 \(") as e:
         load_scenario(path)
     assert e.value.field == "objects[0].resting"
+
+
+def get_object_poses(tmp_path):
+    return list(load_library(tmp_path / "lib")["my_mug"].poses.items())
 
 
 @dataclass(frozen=True)

@@ -154,3 +154,28 @@ def test_suites_may_name_objects_of_user_libraries(tmp_path):
         assert cases[0].truth.category == "cup"
     finally:
         forget_registered()
+
+
+def test_a_user_object_without_a_category_needs_ground_truth(tmp_path):
+    from library_helpers import copy_object
+
+    from tg_drake.objects import forget_registered
+
+    copy_object("cup_01", "thing", tmp_path / "lib", category=None)
+    try:
+        path = write(tmp_path, "kind: synthetic\ndataset: syn\nground_truth: ground_truth.yaml\n"
+                               "object_libraries: [lib]\ngenerator: {objects: [thing]}\n")
+        with pytest.raises(ScenarioError, match="thing has no category") as e:
+            load_suite(path)
+        assert e.value.field == "generator.objects"
+        path = write(tmp_path, "kind: executed\ndataset: robot\nobject_libraries: [lib]\n"
+                               "scenes:\n  - name: a\n    objects: [{id: thing}]\n"
+                               "    task: {task: pass, ground_truth: {tasks: [pass], "
+                               "parts: [middle], reason: x}}\n", name="scenes.yaml")
+        with pytest.raises(ScenarioError, match="give the scene's task.ground_truth.category"):
+            load_suite(path)
+        _, cases = load_suite(write(tmp_path, path.read_text().replace(
+            "reason: x", "category: cup, reason: x"), name="scenes2.yaml"))
+        assert cases[0].truth.category == "cup"
+    finally:
+        forget_registered()

@@ -330,6 +330,10 @@ def _generated(suite: Suite, gt: GroundTruthTables, where: str, gt_where: str) -
     for obj in chosen:
         if obj.id in seen or obj.id in g.exclude:
             continue
+        if obj.category is None:
+            raise ScenarioError(f"{obj.id} has no category, the ground truth a generated case "
+                                "needs (import it with a category)", file=where,
+                                field="generator.objects")
         seen.add(obj.id)
         if min(obj.grasp_widths.values(), default=math.inf) > g.max_grasp_width:
             continue
@@ -418,6 +422,10 @@ def _scenes(suite: Suite, where: str) -> list[Case]:
             target = scenario.target_placement()
             gt = task.ground_truth
             category = gt.category or get_object(target.id).category
+            if category is None:
+                raise ScenarioError(f"{target.id} has no category: give the scene's "
+                                    "task.ground_truth.category", file=where,
+                                    field=f + ".task.ground_truth.category")
             parts = list(variation.parts) if variation.task else list(gt.parts)
             if not gt.reason:
                 raise ScenarioError("a scene's ground truth needs its `reason`", file=where,
