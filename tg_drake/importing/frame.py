@@ -19,9 +19,10 @@ Containers (pan, pot, cup, glass, bowl, bottle, can):
   cut belongs to the part above, as in tools/make_objects.py), plus the handle;
 - an inner surface (faces turned towards the axis, not downwards) over at least OPEN_DEPTH of the
   height makes an open vessel: wall = outer − inner radius across the wall, base = height of the
-  inner bottom, cavity = the water filling the inner surface up to the rim's lowest point. A closed body (a bottle or can
-  scanned from outside) has no inner surface: the wall is a prior (WALL_PRIOR) and the cavity the
-  enclosed volume less a shell of that thickness (first order: section area less perimeter × wall).
+  inner bottom, cavity = the water filling the inner surface up to the rim's lowest point. A
+  closed body (a bottle or can scanned from outside) has no inner surface: the wall is a prior
+  (WALL_PRIOR) and the cavity the enclosed volume less a shell of that thickness (first order:
+  section area less perimeter × wall).
 
 Tools (hammer, knife, screwdriver, cooking_tool):
 
@@ -29,7 +30,8 @@ Tools (hammer, knife, screwdriver, cooking_tool):
 - z: the outward normal, reversed, of the convex hull's facet the tool rests on, found among the
   facets its centre of mass (uniform density) projects into, facing within 60° of the surface's
   thinnest principal axis: the one holding the centre of mass lowest. x is the long axis made
-  perpendicular to z; y = z × x; origin at the bottom centre of the bounding box in O;
+  perpendicular to z and turned (within MAX_X_TURN) to the narrowest bounding box; y = z × x;
+  origin at the bottom centre of the bounding box in O;
 - handle versus usable area: the section width (along y) and thickness (along z) profiles along x
   are fitted, as logarithms, by two constant segments; the split is where one profile, next to the
   best step, has gone a fraction of the way from the handle's level to the usable area's. Which
@@ -41,15 +43,18 @@ Tools (hammer, knife, screwdriver, cooking_tool):
   - screwdriver: the shaft and tip — the narrower segment, from halfway down the width's step (the
     handle's tapered nose is handle);
   - cooking_tool: the spatula head or the ladle bowl — the wider segment, from a quarter of the
-    way up the width's step (a narrowing neck is handle);
+    way up the width's step, or from the narrowest section of a neck before it (a handle
+    narrowing by NECK_NARROWING or more): the neck is handle;
   - unknown category: the segment less like a hand grip (section further from GRIP_SECTION in
     log width + log thickness), from halfway along the larger step; said in the notes.
 
   x points from the handle to the usable area.
 
 Category None: a container when the surface is a body of revolution about a vertical axis
-(REVOLUTION_MIN of the area with horizontal normals has normal lines through one axis) and not
-slender (height below MAX_CONTAINER_ASPECT diameters); otherwise a tool. Said in the notes.
+(REVOLUTION_MIN of the area with horizontal normals has normals pointing at one axis), not
+slender (height at most MAX_CONTAINER_ASPECT body diameters) and not dwarfed by a handle (at most
+MAX_CONTAINER_REACH body diameters across) whose body spans at least MIN_BODY_SHARE of its
+height; otherwise a tool. Said in the notes.
 
 Dimensions [m] — containers: height (body, handle excluded), diameter (the body's largest), wall,
 base, handle_length (how far the handle reaches out from the wall); tools: length, width,
@@ -64,6 +69,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import maximum_filter1d
+from scipy.sparse import coo_matrix
+from scipy.spatial import cKDTree
 
 from tg_drake.errors import ModelError, unknown_name
 from tg_drake.types import CATEGORIES, PART_LABELS
@@ -81,15 +89,29 @@ MIN_CUT_SPACING = 0.0002  # [m] ... at most one per 0.2 mm
 # edge midpoints lie 0.3 % inside its corners) and scan noise, below any handle's thickness.
 HANDLE_CLEARANCE = 0.002
 CUT_TOLERANCE = 5e-4  # [m] a vertex this close below a third's cut belongs to the part above
-COVERAGE = 0.5  # a cut holds the body (or an inner surface) when it has points in this share of sectors
+# a cut holds the body (or an inner surface) when it has points in this share of its sectors
+COVERAGE = 0.5
+INNER_SHARE = 0.2  # ... and this share of the cut's points face the axis (half do in a vessel)
 OPEN_DEPTH = 0.3  # an inner surface over this share of the height makes an open vessel
 # [m] wall of a closed container seen from outside only: bottles are glass (2.5–3 mm) or PET
 # (0.4–0.5 mm), cans aluminium or tinplate (0.15–0.25 mm); other categories: a ceramic-like 3 mm.
 WALL_PRIOR = {"bottle": 0.0015, "can": 0.0002}
 WALL_PRIOR_DEFAULT = 0.003
 REVOLUTION_MIN = 0.5
-REVOLUTION_TOLERANCE = 0.03  # normal lines within this share of the radius (and ≥ 2 mm) cross the axis
+# [°] a normal pointing this close at the axis belongs to a body of revolution (a 24-gon's facets
+# are 7.5° off at their edges)
+REVOLUTION_ANGLE = 10.0
+# [m] normals are averaged over this radius (or 2.5 sample spacings) for that test: a scan's
+# noise (0.3 mm on 3 mm triangles) tilts single triangles by 10° and more; a 30 mm radius wall
+# turns 8° over it
+NORMAL_RADIUS = 0.004
 MAX_CONTAINER_ASPECT = 6.0  # height / diameter: bottles reach about 4.5, a standing screwdriver 7
+# longest horizontal extent / body diameter: a long-handled saucepan reaches about 2.3, a ladle 4
+MAX_CONTAINER_REACH = 3.0
+# body height / overall height: a pan's handle rises above its rim (body 0.67 of it); a ladle
+# standing on its bowl is mostly handle (about 0.1)
+MIN_BODY_SHARE = 0.5
+MAX_X_TURN = 15.0  # [°] search for the narrowest box about the principal axis
 TOOL_BINS = 200  # stations of the section profile along a tool's length
 # Per tool category: which of the two segments is the usable area ("wider" or "narrower" in the
 # profile `channel`: 0 width, 1 thickness), and where the handle ends: where that profile has gone
@@ -98,13 +120,17 @@ TOOL_RULES = {
     # the head: wider; it begins where the section has widened a quarter of the way
     "hammer": ("wider", 0, 0.25, "the head is the wider segment"),
     # the blade: thinner; it begins where the handle starts thinning (the bolster is the blade's)
-    "knife": ("narrower", 1, 0.2, "the blade is the thinner segment, from where the handle thins"),
+    "knife": ("narrower", 1, 0.1, "the blade is the thinner segment, from where the handle thins"),
     # the shaft and tip: narrower; the handle's tapered nose is still handle
     "screwdriver": ("narrower", 0, 0.5, "the shaft and tip are the narrower segment"),
     # the spatula head or ladle bowl: wider, from where the section has widened a quarter of the
     # way (a narrowing neck is handle)
     "cooking_tool": ("wider", 0, 0.25, "the head or bowl is the wider segment"),
 }
+# a cooking tool's neck: a section this much narrower than the handle's median, within this share
+# of the length before the head
+NECK_NARROWING = 0.8
+NECK_SEARCH = 0.15
 GRIP_SECTION = (0.025, 0.02)  # [m] width, thickness of a typical hand grip (unknown category)
 TUKEY_C = 4.685  # Tukey biweight constant (95 % efficiency under Gaussian noise)
 
@@ -288,6 +314,31 @@ def _cuts(V, F, N, levels):
     return np.concatenate(pts), np.concatenate(nrm), np.concatenate(cut), area, length
 
 
+def _row_median(A, mask):
+    """Median of each row of A over its masked entries (NaN where a row has none)."""
+    X = np.where(mask, A, np.nan)
+    out = np.full(len(A), np.nan)
+    ok = mask.any(1)
+    out[ok] = np.nanmedian(X[ok], axis=1)
+    return out
+
+
+def _group_median(key, values, n_keys):
+    """Median of `values` per integer key in 0..n_keys−1 (NaN for keys without values)."""
+    out = np.full(n_keys, np.nan)
+    if len(key) == 0:
+        return out
+    order = np.lexsort((values, key))
+    k, v = key[order], values[order]
+    counts = np.bincount(k, minlength=n_keys)
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    has = counts > 0
+    lo = start[has] + (counts[has] - 1) // 2
+    hi = start[has] + counts[has] // 2
+    out[has] = 0.5 * (v[lo] + v[hi])
+    return out
+
+
 def _sector_reduce(key, values, n_keys, fn, fill):
     out = np.full(n_keys, fill, float)
     fn.at(out, key, values)
@@ -326,17 +377,28 @@ def _apply(X, V):
 # Container or tool from the shape
 
 
-def _revolution_score(P, N):
-    """(share of the horizontal-normal surface whose normal lines cross one vertical axis, axis
-    (x, y), the median radius of those samples)."""
+def _smoothed_normals(P, N, radius):
+    """Sample normals averaged over the samples within `radius` (a scan's noise tilts each
+    triangle's normal by ten degrees and more)."""
+    pairs = cKDTree(P).query_pairs(radius, output_type="ndarray")
+    i, j = np.concatenate([pairs[:, 0], pairs[:, 1]]), np.concatenate([pairs[:, 1], pairs[:, 0]])
+    A = coo_matrix((np.ones(len(i)), (i, j)), shape=(len(P), len(P))).tocsr()
+    S = N + A @ N
+    ln = np.linalg.norm(S, axis=1, keepdims=True)
+    return np.where(ln > 0, S / np.where(ln > 0, ln, 1.0), N)
+
+
+def _revolution_score(P, N, area_total):
+    """(share of the horizontal-normal surface whose normals point at one vertical axis, within
+    REVOLUTION_ANGLE; the axis (x, y); the median radius of those samples [m])."""
+    N = _smoothed_normals(P, N, max(NORMAL_RADIUS, 2.5 * math.sqrt(area_total / len(P))))
     c, dist = _axis_centre(P, N)
     use = np.isfinite(dist)
     if c is None or use.sum() < 10:
         return 0.0, c, 0.0
     r = np.linalg.norm(P[use, :2] - c, axis=1)
-    R = float(np.median(r))
-    tol = max(0.002, REVOLUTION_TOLERANCE * R)
-    return float(np.mean(dist[use] < tol)), c, R
+    hit = dist[use] < math.sin(math.radians(REVOLUTION_ANGLE)) * r
+    return float(np.mean(hit)), c, float(np.median(r[hit])) if hit.any() else 0.0
 
 
 # ------------------------------------------------------------------------------------------------
@@ -368,22 +430,28 @@ def _container(V, F, N, area, category, notes):
     if not body_cut.any():
         raise ModelError("no horizontal cut of the mesh goes round a body: is it upright with z "
                          "up?", field="vertices")
-    with np.errstate(all="ignore"):
-        R_body = np.where(body_cut, np.nanmedian(np.where(occupied, rmax, np.nan), axis=1), np.nan)
+    R_body = np.where(body_cut, _row_median(rmax, occupied), np.nan)
     # per-cut spread of the sector maxima (scan noise), robust
     dev = np.abs(rmax - R_body[:, None])
-    with np.errstate(all="ignore"):
-        spread = np.nanmedian(np.where(occupied & body_cut[:, None], dev, np.nan))
-    tol = HANDLE_CLEARANCE + 3 * 1.4826 * (0.0 if not np.isfinite(spread) else float(spread))
+    sel = occupied & body_cut[:, None]
+    spread = float(np.median(dev[sel])) if sel.any() else 0.0
+    noise = 3 * 1.4826 * (0.0 if not np.isfinite(spread) else float(spread))  # [m] 3σ
+    tol = HANDLE_CLEARANCE + noise
 
     # vertices: handle = outside the body's radius profile (neighbouring cuts too) or above it
     rv = np.linalg.norm(V[:, :2] - c, axis=1)
     kv = np.clip(((V[:, 2] - z0) / dz).astype(int), 0, n_cuts - 1)
     Rb = np.where(body_cut, R_body, -np.inf)
-    Rlim = np.maximum.reduce([Rb[np.clip(kv + j, 0, n_cuts - 1)] for j in (-1, 0, 1)])
-    top_cut = int(np.nonzero(body_cut)[0].max())
-    handle_v = (rv > Rlim + tol) | (kv > top_cut + 1)
-    handle_v &= ~((kv <= top_cut + 1) & ~np.isfinite(Rlim))  # (a gap in the profile: not handle)
+    # the largest body radius within the noise (and a cut) above or below the vertex: a noisy
+    # flat bottom's cuts catch only patches of it
+    half = 1 + int(math.ceil(noise / dz))
+    Rlim = maximum_filter1d(Rb, size=2 * half + 1, mode="nearest")[kv]
+    first_cut, top_cut = (int(i) for i in np.nonzero(body_cut)[0][[0, -1]])
+    # above or below the body (by more than the noise: a pan's handle rises just above its rim)
+    outside = ((V[:, 2] > levels[top_cut] + dz + noise)
+               | (V[:, 2] < levels[first_cut] - dz - noise))
+    # (a gap in the profile between body cuts is not handle)
+    handle_v = outside | (np.isfinite(Rlim) & (rv > Rlim + tol))
     body_v = ~handle_v
     bottom = float(V[body_v, 2].min())
     top = float(V[body_v, 2].max())
@@ -427,26 +495,32 @@ def _container(V, F, N, area, category, notes):
 
     # inner surface: faces turned to the axis and not downwards, inside the body's radius
     inward = (radial < 0) & (Nc[:, 2] > -0.2)
-    rin = _sector_reduce(key[inward], r[inward], n_cuts * SECTORS, np.minimum,
-                         np.inf).reshape(n_cuts, SECTORS)
+    rin = _group_median(key[inward], r[inward], n_cuts * SECTORS).reshape(n_cuts, SECTORS)
     in_occ = np.isfinite(rin)
-    cav_cut = (in_occ.mean(1) >= COVERAGE) & body_cut
+    # an inner surface holds a fair share of the cut (not a few stray faces turned inwards)
+    share = np.bincount(kc[inward], minlength=n_cuts) / np.maximum(
+        np.bincount(kc, minlength=n_cuts), 1)
+    cav_cut = (in_occ.mean(1) >= COVERAGE) & body_cut & (share >= INNER_SHARE)
     cav_idx = np.nonzero(cav_cut)[0]
     depth = (cav_idx.max() - cav_idx.min() + 1) * dz if len(cav_idx) else 0.0
     is_open = depth >= OPEN_DEPTH * H
     Rmax = float(np.nanmax(R_body))
     dims = {"height": H, "diameter": 2 * Rmax}
     if is_open:
-        with np.errstate(all="ignore"):
-            R_in = np.nanmedian(np.where(in_occ, rin, np.nan), axis=1)
-            nr_key = kc[inward]
-            nr_med = np.array([np.median(-radial[inward][nr_key == k]) if (nr_key == k).any()
-                               else np.nan for k in range(n_cuts)])
+        R_in = _row_median(rin, in_occ)
+        # a sector far off its cut's median (a handle's inner side) takes the median
+        far = np.abs(rin - R_in[:, None]) > np.maximum(0.1 * R_in[:, None], 0.002)
+        rin = np.where(in_occ & far, R_in[:, None], rin)
+        outward = radial > 0.3
+        rout = _group_median(key[outward], r[outward], n_cuts * SECTORS).reshape(n_cuts, SECTORS)
+        R_out = _row_median(rout, np.isfinite(rout))
         lo, hi = levels[cav_idx.min()], levels[cav_idx.max()]
         mid = cav_cut & (levels > lo + 0.3 * (hi - lo)) & (levels < lo + 0.7 * (hi - lo))
         if not mid.any():
             mid = cav_cut
-        wall = float(np.nanmedian((R_body - R_in)[mid] * nr_med[mid]))
+        # across the wall: the radial gap times the cosine of the wall's tilt from vertical
+        tilt_cos = float(np.median(-radial[inward & mid[kc]]))
+        wall = float(np.nanmedian((R_out - R_in)[mid])) * tilt_cos
         # base: the inner bottom — upward faces near the axis, else the lowest cut with a cavity
         up = (Ns[:, 2] > 0.9) & (np.linalg.norm(P[:, :2] - c, axis=1) < 0.5 * R_in[cav_idx[0]]) \
             & (P[:, 2] < lo + 0.25 * (hi - lo))
@@ -458,9 +532,9 @@ def _container(V, F, N, area, category, notes):
         crest = _sector_reduce(sec_v, bv[:, 2], SECTORS, np.maximum, -np.inf)
         fill = bottom + float(crest[np.isfinite(crest)].min())
         full = cav_cut & (levels <= fill) & (levels >= bottom + base)
-        with np.errstate(all="ignore"):
-            sq = np.where(in_occ, rin ** 2, np.nan)
-            a_cut = np.pi * np.nanmean(sq, axis=1)  # polar area over the sectors
+        n_in = in_occ.sum(1)
+        # polar area over the sectors
+        a_cut = np.pi * np.where(in_occ, rin, 0.0) ** 2 @ np.ones(SECTORS) / np.maximum(n_in, 1)
         a_cut = np.where(full, np.nan_to_num(a_cut), 0.0)
         vol = float(a_cut.sum() * dz)
         cz = float((a_cut * (levels - bottom)).sum() * dz / vol) if vol > 0 else 0.0
@@ -570,6 +644,13 @@ def _tool(V, F, N, area, category, notes):
     x = e1 - (e1 @ z) * z
     x /= np.linalg.norm(x)
     y = np.cross(z, x)
+    # x turned in the resting plane, within ±MAX_X_TURN of the principal axis, to the narrowest
+    # bounding box (a knife's offset blade tilts the principal axis off its spine)
+    uv = V @ np.stack([x, y]).T
+    phi = np.radians(np.arange(-MAX_X_TURN, MAX_X_TURN + 1e-9, 0.25))
+    wy = -np.sin(phi)[:, None] * uv[:, 0] + np.cos(phi)[:, None] * uv[:, 1]  # y after turning
+    turn = phi[int(np.argmin(np.ptp(wy, axis=1) + 1e-9 * np.abs(phi)))]
+    x, y = math.cos(turn) * x + math.sin(turn) * y, -math.sin(turn) * x + math.cos(turn) * y
     R = np.stack([x, y, z])
     q = P @ R.T
     qv = V @ R.T
@@ -613,6 +694,17 @@ def _tool(V, F, N, area, category, notes):
         split = float(xc[j] + t * (xc[j + 1] - xc[j]))
     else:
         split = float(edges[k])
+    if category == "cooking_tool":
+        # a neck (the handle narrowing before the head) is handle up to its narrowest section
+        side = (xc < split) if usable_high else (xc > split)
+        near = side & (np.abs(xc - split) < NECK_SEARCH * (x1 - x0))
+        if near.any():
+            j = int(np.flatnonzero(near)[np.argmin(S[near, ch])])
+            if S[j, ch] < h_lvl + math.log(NECK_NARROWING):
+                # a bin reports its widest section: the narrowest lies up to a bin further on
+                step = edges[1] - edges[0]
+                split = float(edges[j + 1] + step if usable_high else edges[j] - step)
+                rule += "; the neck is handle up to its narrowest section"
     if not usable_high:
         R = np.stack([-x, -y, z])
         qv = V @ R.T
@@ -650,18 +742,37 @@ def derive_frame(vertices: np.ndarray, faces: np.ndarray, category: str | None, 
     notes: list[str] = []
     if category is None:
         P, Ns = _samples(V, F, N, area)
-        score, c, Rm = _revolution_score(P, Ns)
+        score, c, Rm = _revolution_score(P, Ns, float(area.sum()))
         aspect = float(np.ptp(V[:, 2]) / (2 * Rm)) if Rm > 0 else np.inf
-        is_container = score >= REVOLUTION_MIN and aspect <= MAX_CONTAINER_ASPECT
+        th = np.linspace(0, np.pi, 90, endpoint=False)
+        proj = V[:, :2] @ np.stack([np.cos(th), np.sin(th)])
+        reach = float((proj.max(0) - proj.min(0)).max() / (2 * Rm)) if Rm > 0 else np.inf
+        is_container = (score >= REVOLUTION_MIN and aspect <= MAX_CONTAINER_ASPECT
+                        and reach <= MAX_CONTAINER_REACH)
         notes.append(f"category not given: {'a container' if is_container else 'a tool'} from the "
-                     f"shape ({100 * score:.0f} % of the side surface is a body of revolution "
-                     f"about a vertical axis, needed {100 * REVOLUTION_MIN:.0f} %; height "
-                     f"{aspect:.1f} diameters, at most {MAX_CONTAINER_ASPECT:g})")
+                     f"shape ({100 * score:.0f} % of the side surface faces one vertical axis, "
+                     f"needed {100 * REVOLUTION_MIN:.0f} %; height {aspect:.1f} diameters, at "
+                     f"most {MAX_CONTAINER_ASPECT:g}; {reach:.1f} diameters across, at most "
+                     f"{MAX_CONTAINER_REACH:g})")
     else:
         is_container = category not in TOOL_CATEGORIES
+    container = None
     if is_container:
-        X_OM, lab, parts, dims, widths, vol, cen, open_wall = _container(V, F, N, area,
-                                                                        category, notes)
+        try:
+            container = _container(V, F, N, area, category, notes)
+        except ModelError:
+            if category is not None:
+                raise
+        if category is None:
+            share = 0.0 if container is None else container[3]["height"] / float(np.ptp(V[:, 2]))
+            if share < MIN_BODY_SHARE:
+                notes.clear()
+                notes.append(f"category not given: a tool from the shape (its body of revolution "
+                             f"spans {100 * share:.0f} % of its height, less than "
+                             f"{100 * MIN_BODY_SHARE:.0f} %: a bowl on a handle)")
+                container = None
+    if container is not None:
+        X_OM, lab, parts, dims, widths, vol, cen, open_wall = container
         kind, cavity_volume, cavity_centroid = "container", vol, cen
     else:
         X_OM, lab, parts, dims, widths = _tool(V, F, N, area, category, notes)
