@@ -81,9 +81,9 @@ def text(d: Decisions, warnings: tuple[str, ...]) -> str:
     ]
     for k, s in enumerate(d.poses[:MAX_PICTURES]):
         r = s.resting
+        deg = ", ".join(str(round(float(np.degrees(a)))) for a in r.rpy)  # no "-0"
         lines.append(f"    {k}: {s.name or '-':10s} p={s.probability:.2f}  "
-                     f"z={1000 * r.xyz[2]:.1f} mm"
-                     f"  rpy=[{', '.join(f'{np.degrees(a):.0f}' for a in r.rpy)}]°  support "
+                     f"z={1000 * r.xyz[2]:.1f} mm  rpy=[{deg}]°  support "
                      f"margin {1000 * r.support_margin:.1f} mm")
     if len(d.poses) > MAX_PICTURES:
         lines.append(f"    ... {len(d.poses) - MAX_PICTURES} less probable ones")
