@@ -82,6 +82,7 @@ TOP, MIDDLE, BOTTOM, HANDLE, USABLE = (PART_LABELS.index(p) for p in
 
 N_SAMPLES = 20000  # surface samples (area-uniform) for the fits; a fixed seed keeps them repeatable
 SAMPLE_SEED = 0
+N_SCORE = 8000  # of them for the body-of-revolution test (container or tool)
 SECTORS = 36  # angular sectors of a cut (10° each: a handle spans only a few)
 N_CUTS = 240  # horizontal cuts over a container's height ...
 MIN_CUT_SPACING = 0.0002  # [m] ... at most one per 0.2 mm
@@ -378,19 +379,20 @@ def _apply(X, V):
 
 
 def _smoothed_normals(P, N, radius):
-    """Sample normals averaged over the samples within `radius` (a scan's noise tilts each
-    triangle's normal by ten degrees and more)."""
+    """Sample normals averaged over the samples within `radius` that face the same side (a
+    scan's noise tilts each triangle's normal by ten degrees and more; the two sides of a thin
+    wall must not cancel)."""
     pairs = cKDTree(P).query_pairs(radius, output_type="ndarray")
+    pairs = pairs[np.einsum("ij,ij->i", N[pairs[:, 0]], N[pairs[:, 1]]) > 0]
     i, j = np.concatenate([pairs[:, 0], pairs[:, 1]]), np.concatenate([pairs[:, 1], pairs[:, 0]])
-    A = coo_matrix((np.ones(len(i)), (i, j)), shape=(len(P), len(P))).tocsr()
-    S = N + A @ N
-    ln = np.linalg.norm(S, axis=1, keepdims=True)
-    return np.where(ln > 0, S / np.where(ln > 0, ln, 1.0), N)
+    S = N + coo_matrix((np.ones(len(i)), (i, j)), shape=(len(P), len(P))).tocsr() @ N
+    return S / np.linalg.norm(S, axis=1, keepdims=True)
 
 
 def _revolution_score(P, N, area_total):
     """(share of the horizontal-normal surface whose normals point at one vertical axis, within
     REVOLUTION_ANGLE; the axis (x, y); the median radius of those samples [m])."""
+    P, N = P[:N_SCORE], N[:N_SCORE]  # (the samples are in random order)
     N = _smoothed_normals(P, N, max(NORMAL_RADIUS, 2.5 * math.sqrt(area_total / len(P))))
     c, dist = _axis_centre(P, N)
     use = np.isfinite(dist)
