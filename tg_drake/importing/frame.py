@@ -407,8 +407,7 @@ def _revolution_score(P, N, area_total):
 # Containers
 
 
-def _container(V, F, N, area, category, notes):
-    P, Ns = _samples(V, F, N, area)
+def _container(V, F, N, area, P, Ns, category, notes):
     c, _ = _axis_centre(P, Ns)
     if c is None:
         c = 0.5 * (V[:, :2].min(0) + V[:, :2].max(0))
@@ -628,8 +627,7 @@ def _two_segments(S):
     return int(k[np.argmin(sse)])
 
 
-def _tool(V, F, N, area, category, notes):
-    P, Ns = _samples(V, F, N, area)
+def _tool(V, F, N, area, P, Ns, category, notes):
     mu = P.mean(0)
     _, _, Wt = np.linalg.svd(P - mu, full_matrices=False)
     e1, e3 = Wt[0], Wt[2]
@@ -742,8 +740,8 @@ def derive_frame(vertices: np.ndarray, faces: np.ndarray, category: str | None, 
     V, F, L = _check(vertices, faces, category, labels)
     N, area = _face_geometry(V, F)
     notes: list[str] = []
+    P, Ns = _samples(V, F, N, area)
     if category is None:
-        P, Ns = _samples(V, F, N, area)
         score, c, Rm = _revolution_score(P, Ns, float(area.sum()))
         aspect = float(np.ptp(V[:, 2]) / (2 * Rm)) if Rm > 0 else np.inf
         th = np.linspace(0, np.pi, 90, endpoint=False)
@@ -761,7 +759,7 @@ def derive_frame(vertices: np.ndarray, faces: np.ndarray, category: str | None, 
     container = None
     if is_container:
         try:
-            container = _container(V, F, N, area, category, notes)
+            container = _container(V, F, N, area, P, Ns, category, notes)
         except ModelError:
             if category is not None:
                 raise
@@ -777,7 +775,7 @@ def derive_frame(vertices: np.ndarray, faces: np.ndarray, category: str | None, 
         X_OM, lab, parts, dims, widths, vol, cen, open_wall = container
         kind, cavity_volume, cavity_centroid = "container", vol, cen
     else:
-        X_OM, lab, parts, dims, widths = _tool(V, F, N, area, category, notes)
+        X_OM, lab, parts, dims, widths = _tool(V, F, N, area, P, Ns, category, notes)
         kind, cavity_volume, cavity_centroid, open_wall = "tool", None, None, None
     if L is not None:
         lab = L
