@@ -271,10 +271,11 @@ def _axis_centre(P, N):
     return c, dist
 
 
-def _cuts(V, F, N, levels):
-    """Horizontal cuts of the mesh at `levels`: for every cut, the points (both ends and the middle
-    of each face's segment) with their face normals, the cut index of each point, and per cut the
-    enclosed material area and the cut's length (Green's theorem on the oriented segments)."""
+def _cuts(V, F, N, levels, c):
+    """Horizontal cuts of the mesh at `levels`: for every cut, points along each face's segment
+    (denser the further round the axis (x, y) = `c` it reaches) with their face normals, the cut
+    index of each point, and per cut the enclosed material area and the cut's length (Green's
+    theorem on the oriented segments)."""
     Fz = V[F][:, :, 2]
     fzmin, fzmax = Fz.min(1), Fz.max(1)
     pts, nrm, cut = [], [], []
@@ -307,9 +308,18 @@ def _cuts(V, F, N, levels):
         b2 = np.where(flip[:, None], a, b)
         area[k] = 0.5 * np.sum(a2[:, 0] * b2[:, 1] - a2[:, 1] * b2[:, 0])
         length[k] = np.linalg.norm((b - a)[:, :2], axis=1).sum()
-        pts += [a, b, 0.5 * (a + b)]
-        nrm += [n, n, n]
-        cut.append(np.full(3 * len(idx), k))
+        # points along each segment, at least two per angular sector it spans about the axis
+        # (a coarse CAD mesh's long triangles cut into few, long segments)
+        seg = np.linalg.norm((b - a)[:, :2], axis=1)
+        r_mid = np.linalg.norm(0.5 * (a + b)[:, :2] - c, axis=1)
+        h = np.maximum(0.25 * (r_mid + seg) * 2 * np.pi / SECTORS, 1e-4)
+        n_pts = np.clip(np.ceil(seg / h).astype(int), 2, 64) + 1
+        rep = np.repeat(np.arange(len(idx)), n_pts)
+        t = (np.arange(len(rep)) - np.repeat(np.cumsum(n_pts) - n_pts, n_pts)) / (
+            np.repeat(n_pts, n_pts) - 1)
+        pts.append(a[rep] + t[:, None] * (b - a)[rep])
+        nrm.append(n[rep])
+        cut.append(np.full(len(rep), k))
     if not pts:
         return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, int), area, length
     return np.concatenate(pts), np.concatenate(nrm), np.concatenate(cut), area, length
@@ -416,7 +426,7 @@ def _container(V, F, N, area, P, Ns, category, notes):
     n_cuts = int(min(N_CUTS, max(8, math.ceil((z1 - z0) / MIN_CUT_SPACING))))
     dz = (z1 - z0) / n_cuts
     levels = z0 + (np.arange(n_cuts) + 0.5) * dz
-    Pc, Nc, kc, sec_area, sec_len = _cuts(V, F, N, levels)
+    Pc, Nc, kc, sec_area, sec_len = _cuts(V, F, N, levels, c)
     rel = Pc[:, :2] - c
     r = np.linalg.norm(rel, axis=1)
     th = np.arctan2(rel[:, 1], rel[:, 0])
@@ -454,6 +464,10 @@ def _container(V, F, N, area, P, Ns, category, notes):
     # (a gap in the profile between body cuts is not handle)
     handle_v = outside | (np.isfinite(Rlim) & (rv > Rlim + tol))
     body_v = ~handle_v
+    if not body_v.any() or np.ptp(V[body_v, 2]) <= 0:
+        raise ModelError("the mesh has no body of revolution about a vertical axis (everything "
+                         "lies outside its radius profile): is it upright with z up?",
+                         field="vertices")
     bottom = float(V[body_v, 2].min())
     top = float(V[body_v, 2].max())
     H = top - bottom
@@ -504,7 +518,7 @@ def _container(V, F, N, area, P, Ns, category, notes):
     cav_cut = (in_occ.mean(1) >= COVERAGE) & body_cut & (share >= INNER_SHARE)
     cav_idx = np.nonzero(cav_cut)[0]
     depth = (cav_idx.max() - cav_idx.min() + 1) * dz if len(cav_idx) else 0.0
-    is_open = depth >= OPEN_DEPTH * H
+    is_open = len(cav_idx) > 0 and depth >= OPEN_DEPTH * H
     Rmax = float(np.nanmax(R_body))
     dims = {"height": H, "diameter": 2 * Rmax}
     if is_open:
