@@ -306,6 +306,8 @@ def _cuts(V, F, N, levels, c):
         flip = ((b - a)[:, :2] * d).sum(1) < 0
         a2 = np.where(flip[:, None], b, a)
         b2 = np.where(flip[:, None], a, b)
+        # about the axis: a hole's open ends then cost only the sliver between them and it
+        a2, b2 = a2[:, :2] - c, b2[:, :2] - c
         area[k] = 0.5 * np.sum(a2[:, 0] * b2[:, 1] - a2[:, 1] * b2[:, 0])
         length[k] = np.linalg.norm((b - a)[:, :2], axis=1).sum()
         # points along each segment, at least two per angular sector it spans about the axis
