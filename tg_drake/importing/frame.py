@@ -17,12 +17,13 @@ Containers (pan, pot, cup, glass, bowl, bottle, can):
   there are two); without a handle the input's x direction is kept;
 - parts: bottom, middle, top thirds of the body's height (a vertex within CUT_TOLERANCE below a
   cut belongs to the part above, as in tools/make_objects.py), plus the handle;
-- an inner surface (faces turned towards the axis, not downwards) over at least OPEN_DEPTH of the
-  height makes an open vessel: wall = outer − inner radius across the wall, base = height of the
-  inner bottom, cavity = the water filling the inner surface up to the rim's lowest point. A
-  closed body (a bottle or can scanned from outside) has no inner surface: the wall is a prior
-  (WALL_PRIOR) and the cavity the enclosed volume less a shell of that thickness (first order:
-  section area less perimeter × wall).
+- an inner surface (faces turned towards the axis, not downwards, at least INNER_SHARE of a cut)
+  over at least OPEN_DEPTH of the height makes an open vessel (radii are per-sector medians):
+  wall = outer − inner radius across the wall, base = height of the inner bottom, cavity = the
+  water filling the inner surface up to the rim's lowest point. A closed body (a bottle or can
+  scanned from outside) has no inner surface: the wall is a prior (WALL_PRIOR) and the cavity the
+  enclosed volume less a shell of that thickness (first order: section area less perimeter ×
+  wall).
 
 Tools (hammer, knife, screwdriver, cooking_tool):
 
@@ -38,7 +39,7 @@ Tools (hammer, knife, screwdriver, cooking_tool):
   segment is the usable area, and where it begins, is a rule per category (TOOL_RULES):
 
   - hammer: the head — the wider segment, from a quarter of the way up the width's step;
-  - knife: the blade — the thinner segment, from where the handle has thinned a fifth of the way
+  - knife: the blade — the thinner segment, from where the handle has thinned a tenth of the way
     (the bolster is the blade's);
   - screwdriver: the shaft and tip — the narrower segment, from halfway down the width's step (the
     handle's tapered nose is handle);
@@ -51,7 +52,8 @@ Tools (hammer, knife, screwdriver, cooking_tool):
   x points from the handle to the usable area.
 
 Category None: a container when the surface is a body of revolution about a vertical axis
-(REVOLUTION_MIN of the area with horizontal normals has normals pointing at one axis), not
+(REVOLUTION_MIN of the area with horizontal normals, averaged over NORMAL_RADIUS, has normals
+pointing at one axis within REVOLUTION_ANGLE), not
 slender (height at most MAX_CONTAINER_ASPECT body diameters) and not dwarfed by a handle (at most
 MAX_CONTAINER_REACH body diameters across) whose body spans at least MIN_BODY_SHARE of its
 height; otherwise a tool. Said in the notes.
