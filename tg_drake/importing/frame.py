@@ -71,6 +71,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import trimesh
 from scipy.ndimage import maximum_filter1d
 from scipy.sparse import coo_matrix
 from scipy.spatial import cKDTree
@@ -595,8 +596,6 @@ def _container(V, F, N, area, P, Ns, category, notes):
 
 def _resting_normal(V, F, area, e3):
     """Outward normal of the hull facet the tool rests on (see the module docstring)."""
-    import trimesh
-
     com, _ = _centre_of_mass(V, F, area)
     hull = trimesh.convex.convex_hull(V)
     hf = hull.faces
