@@ -17,12 +17,13 @@ Containers (pan, pot, cup, glass, bowl, bottle, can):
   there are two); without a handle the input's x direction is kept;
 - parts: bottom, middle, top thirds of the body's height (a vertex within CUT_TOLERANCE below a
   cut belongs to the part above, as in tools/make_objects.py), plus the handle;
-- an inner surface (faces turned towards the axis, not downwards) over at least OPEN_DEPTH of the
-  height makes an open vessel: wall = outer − inner radius across the wall, base = height of the
-  inner bottom, cavity = the water filling the inner surface up to the rim's lowest point. A
-  closed body (a bottle or can scanned from outside) has no inner surface: the wall is a prior
-  (WALL_PRIOR) and the cavity the enclosed volume less a shell of that thickness (first order:
-  section area less perimeter × wall).
+- an inner surface (faces turned towards the axis, not downwards, at least INNER_SHARE of a cut)
+  over at least OPEN_DEPTH of the height makes an open vessel (radii are per-sector medians):
+  wall = outer − inner radius across the wall, base = height of the inner bottom, cavity = the
+  water filling the inner surface up to the rim's lowest point. A closed body (a bottle or can
+  scanned from outside) has no inner surface: the wall is a prior (WALL_PRIOR) and the cavity the
+  enclosed volume less a shell of that thickness (first order: section area less perimeter ×
+  wall).
 
 Tools (hammer, knife, screwdriver, cooking_tool):
 
@@ -38,7 +39,7 @@ Tools (hammer, knife, screwdriver, cooking_tool):
   segment is the usable area, and where it begins, is a rule per category (TOOL_RULES):
 
   - hammer: the head — the wider segment, from a quarter of the way up the width's step;
-  - knife: the blade — the thinner segment, from where the handle has thinned a fifth of the way
+  - knife: the blade — the thinner segment, from where the handle has thinned a tenth of the way
     (the bolster is the blade's);
   - screwdriver: the shaft and tip — the narrower segment, from halfway down the width's step (the
     handle's tapered nose is handle);
@@ -51,7 +52,8 @@ Tools (hammer, knife, screwdriver, cooking_tool):
   x points from the handle to the usable area.
 
 Category None: a container when the surface is a body of revolution about a vertical axis
-(REVOLUTION_MIN of the area with horizontal normals has normals pointing at one axis), not
+(REVOLUTION_MIN of the area with horizontal normals, averaged over NORMAL_RADIUS, has normals
+pointing at one axis within REVOLUTION_ANGLE), not
 slender (height at most MAX_CONTAINER_ASPECT body diameters) and not dwarfed by a handle (at most
 MAX_CONTAINER_REACH body diameters across) whose body spans at least MIN_BODY_SHARE of its
 height; otherwise a tool. Said in the notes.
@@ -69,6 +71,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import trimesh
 from scipy.ndimage import maximum_filter1d
 from scipy.sparse import coo_matrix
 from scipy.spatial import cKDTree
@@ -82,6 +85,7 @@ TOP, MIDDLE, BOTTOM, HANDLE, USABLE = (PART_LABELS.index(p) for p in
 
 N_SAMPLES = 20000  # surface samples (area-uniform) for the fits; a fixed seed keeps them repeatable
 SAMPLE_SEED = 0
+N_SCORE = 8000  # of them for the body-of-revolution test (container or tool)
 SECTORS = 36  # angular sectors of a cut (10° each: a handle spans only a few)
 N_CUTS = 240  # horizontal cuts over a container's height ...
 MIN_CUT_SPACING = 0.0002  # [m] ... at most one per 0.2 mm
@@ -270,10 +274,11 @@ def _axis_centre(P, N):
     return c, dist
 
 
-def _cuts(V, F, N, levels):
-    """Horizontal cuts of the mesh at `levels`: for every cut, the points (both ends and the middle
-    of each face's segment) with their face normals, the cut index of each point, and per cut the
-    enclosed material area and the cut's length (Green's theorem on the oriented segments)."""
+def _cuts(V, F, N, levels, c):
+    """Horizontal cuts of the mesh at `levels`: for every cut, points along each face's segment
+    (denser the further round the axis (x, y) = `c` it reaches) with their face normals, the cut
+    index of each point, and per cut the enclosed material area and the cut's length (Green's
+    theorem on the oriented segments)."""
     Fz = V[F][:, :, 2]
     fzmin, fzmax = Fz.min(1), Fz.max(1)
     pts, nrm, cut = [], [], []
@@ -304,11 +309,22 @@ def _cuts(V, F, N, levels):
         flip = ((b - a)[:, :2] * d).sum(1) < 0
         a2 = np.where(flip[:, None], b, a)
         b2 = np.where(flip[:, None], a, b)
+        # about the axis: a hole's open ends then cost only the sliver between them and it
+        a2, b2 = a2[:, :2] - c, b2[:, :2] - c
         area[k] = 0.5 * np.sum(a2[:, 0] * b2[:, 1] - a2[:, 1] * b2[:, 0])
         length[k] = np.linalg.norm((b - a)[:, :2], axis=1).sum()
-        pts += [a, b, 0.5 * (a + b)]
-        nrm += [n, n, n]
-        cut.append(np.full(3 * len(idx), k))
+        # points along each segment, at least two per angular sector it spans about the axis
+        # (a coarse CAD mesh's long triangles cut into few, long segments)
+        seg = np.linalg.norm((b - a)[:, :2], axis=1)
+        r_mid = np.linalg.norm(0.5 * (a + b)[:, :2] - c, axis=1)
+        h = np.maximum(0.25 * (r_mid + seg) * 2 * np.pi / SECTORS, 1e-4)
+        n_pts = np.clip(np.ceil(seg / h).astype(int), 2, 64) + 1
+        rep = np.repeat(np.arange(len(idx)), n_pts)
+        t = (np.arange(len(rep)) - np.repeat(np.cumsum(n_pts) - n_pts, n_pts)) / (
+            np.repeat(n_pts, n_pts) - 1)
+        pts.append(a[rep] + t[:, None] * (b - a)[rep])
+        nrm.append(n[rep])
+        cut.append(np.full(len(rep), k))
     if not pts:
         return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, int), area, length
     return np.concatenate(pts), np.concatenate(nrm), np.concatenate(cut), area, length
@@ -378,19 +394,20 @@ def _apply(X, V):
 
 
 def _smoothed_normals(P, N, radius):
-    """Sample normals averaged over the samples within `radius` (a scan's noise tilts each
-    triangle's normal by ten degrees and more)."""
+    """Sample normals averaged over the samples within `radius` that face the same side (a
+    scan's noise tilts each triangle's normal by ten degrees and more; the two sides of a thin
+    wall must not cancel)."""
     pairs = cKDTree(P).query_pairs(radius, output_type="ndarray")
+    pairs = pairs[np.einsum("ij,ij->i", N[pairs[:, 0]], N[pairs[:, 1]]) > 0]
     i, j = np.concatenate([pairs[:, 0], pairs[:, 1]]), np.concatenate([pairs[:, 1], pairs[:, 0]])
-    A = coo_matrix((np.ones(len(i)), (i, j)), shape=(len(P), len(P))).tocsr()
-    S = N + A @ N
-    ln = np.linalg.norm(S, axis=1, keepdims=True)
-    return np.where(ln > 0, S / np.where(ln > 0, ln, 1.0), N)
+    S = N + coo_matrix((np.ones(len(i)), (i, j)), shape=(len(P), len(P))).tocsr() @ N
+    return S / np.linalg.norm(S, axis=1, keepdims=True)
 
 
 def _revolution_score(P, N, area_total):
     """(share of the horizontal-normal surface whose normals point at one vertical axis, within
     REVOLUTION_ANGLE; the axis (x, y); the median radius of those samples [m])."""
+    P, N = P[:N_SCORE], N[:N_SCORE]  # (the samples are in random order)
     N = _smoothed_normals(P, N, max(NORMAL_RADIUS, 2.5 * math.sqrt(area_total / len(P))))
     c, dist = _axis_centre(P, N)
     use = np.isfinite(dist)
@@ -405,8 +422,7 @@ def _revolution_score(P, N, area_total):
 # Containers
 
 
-def _container(V, F, N, area, category, notes):
-    P, Ns = _samples(V, F, N, area)
+def _container(V, F, N, area, P, Ns, category, notes):
     c, _ = _axis_centre(P, Ns)
     if c is None:
         c = 0.5 * (V[:, :2].min(0) + V[:, :2].max(0))
@@ -415,7 +431,7 @@ def _container(V, F, N, area, category, notes):
     n_cuts = int(min(N_CUTS, max(8, math.ceil((z1 - z0) / MIN_CUT_SPACING))))
     dz = (z1 - z0) / n_cuts
     levels = z0 + (np.arange(n_cuts) + 0.5) * dz
-    Pc, Nc, kc, sec_area, sec_len = _cuts(V, F, N, levels)
+    Pc, Nc, kc, sec_area, sec_len = _cuts(V, F, N, levels, c)
     rel = Pc[:, :2] - c
     r = np.linalg.norm(rel, axis=1)
     th = np.arctan2(rel[:, 1], rel[:, 0])
@@ -453,6 +469,10 @@ def _container(V, F, N, area, category, notes):
     # (a gap in the profile between body cuts is not handle)
     handle_v = outside | (np.isfinite(Rlim) & (rv > Rlim + tol))
     body_v = ~handle_v
+    if not body_v.any() or np.ptp(V[body_v, 2]) <= 0:
+        raise ModelError("the mesh has no body of revolution about a vertical axis (everything "
+                         "lies outside its radius profile): is it upright with z up?",
+                         field="vertices")
     bottom = float(V[body_v, 2].min())
     top = float(V[body_v, 2].max())
     H = top - bottom
@@ -503,7 +523,7 @@ def _container(V, F, N, area, category, notes):
     cav_cut = (in_occ.mean(1) >= COVERAGE) & body_cut & (share >= INNER_SHARE)
     cav_idx = np.nonzero(cav_cut)[0]
     depth = (cav_idx.max() - cav_idx.min() + 1) * dz if len(cav_idx) else 0.0
-    is_open = depth >= OPEN_DEPTH * H
+    is_open = len(cav_idx) > 0 and depth >= OPEN_DEPTH * H
     Rmax = float(np.nanmax(R_body))
     dims = {"height": H, "diameter": 2 * Rmax}
     if is_open:
@@ -576,8 +596,6 @@ def _container(V, F, N, area, category, notes):
 
 def _resting_normal(V, F, area, e3):
     """Outward normal of the hull facet the tool rests on (see the module docstring)."""
-    import trimesh
-
     com, _ = _centre_of_mass(V, F, area)
     hull = trimesh.convex.convex_hull(V)
     hf = hull.faces
@@ -626,8 +644,7 @@ def _two_segments(S):
     return int(k[np.argmin(sse)])
 
 
-def _tool(V, F, N, area, category, notes):
-    P, Ns = _samples(V, F, N, area)
+def _tool(V, F, N, area, P, Ns, category, notes):
     mu = P.mean(0)
     _, _, Wt = np.linalg.svd(P - mu, full_matrices=False)
     e1, e3 = Wt[0], Wt[2]
@@ -740,8 +757,8 @@ def derive_frame(vertices: np.ndarray, faces: np.ndarray, category: str | None, 
     V, F, L = _check(vertices, faces, category, labels)
     N, area = _face_geometry(V, F)
     notes: list[str] = []
+    P, Ns = _samples(V, F, N, area)
     if category is None:
-        P, Ns = _samples(V, F, N, area)
         score, c, Rm = _revolution_score(P, Ns, float(area.sum()))
         aspect = float(np.ptp(V[:, 2]) / (2 * Rm)) if Rm > 0 else np.inf
         th = np.linspace(0, np.pi, 90, endpoint=False)
@@ -759,7 +776,7 @@ def derive_frame(vertices: np.ndarray, faces: np.ndarray, category: str | None, 
     container = None
     if is_container:
         try:
-            container = _container(V, F, N, area, category, notes)
+            container = _container(V, F, N, area, P, Ns, category, notes)
         except ModelError:
             if category is not None:
                 raise
@@ -775,7 +792,7 @@ def derive_frame(vertices: np.ndarray, faces: np.ndarray, category: str | None, 
         X_OM, lab, parts, dims, widths, vol, cen, open_wall = container
         kind, cavity_volume, cavity_centroid = "container", vol, cen
     else:
-        X_OM, lab, parts, dims, widths = _tool(V, F, N, area, category, notes)
+        X_OM, lab, parts, dims, widths = _tool(V, F, N, area, P, Ns, category, notes)
         kind, cavity_volume, cavity_centroid, open_wall = "tool", None, None, None
     if L is not None:
         lab = L
