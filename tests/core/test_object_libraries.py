@@ -8,6 +8,7 @@ from argparse import Namespace
 import numpy as np
 import pytest
 import yaml
+from library_helpers import copy_object
 
 from tg_drake.errors import ModelError, ScenarioError
 from tg_drake.objects import (
@@ -20,7 +21,6 @@ from tg_drake.objects import (
     register_object,
     shipped_root,
 )
-from library_helpers import copy_object
 
 
 @pytest.fixture(autouse=True)

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import inspect
 import json
 import os
 import shutil
@@ -323,15 +322,9 @@ def merge_entry(path: Path, obj_id: str, entry: dict) -> None:
 
 
 def load_object(library_dir: Path, obj_id: str) -> objects.LibraryObject:
-    """The object `obj_id` of the library folder, read back through tg_drake.objects."""
-    load = objects.load_library
-    if inspect.signature(load).parameters:  # load_library(path): issue 18's user libraries
-        # (uncached: the folder was just written, an earlier read of it is stale)
-        lib = getattr(load, "__wrapped__", load)(Path(library_dir))
-        return lib[obj_id]
-    # the shipped-library-only objects.py: the entry through its reader (directory not yet root)
-    data = yaml.safe_load((Path(library_dir) / "library.yaml").read_text())
-    return objects._object(obj_id, data["objects"][obj_id])
+    """The object `obj_id` of the library folder, read back through tg_drake.objects (which
+    reads a folder again when its library.yaml has changed)."""
+    return objects.load_library(Path(library_dir))[obj_id]
 
 
 # ------------------------------------------------------------------------------------------------
