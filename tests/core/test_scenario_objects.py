@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import sys
-import types
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -130,21 +127,11 @@ def get_object_poses(tmp_path):
     return list(load_library(tmp_path / "lib")["my_mug"].poses.items())
 
 
-@dataclass(frozen=True)
-class _FakeOptions:
-    category: str | None = None
-    obj_id: str | None = None
-    units: str = "auto"
-    up_axis: str = "z"
-    mass: float | None = None
-    density: float | None = None
-    labels: Path | None = None
-    collision: str = "coacd"
-
-
 @pytest.fixture
 def fake_importer(tmp_path, monkeypatch):
-    """tg_drake.importing stood in for by one that 'imports' a shipped cup into a library."""
+    """tg_drake.importing's import_cached stood in for by one that 'imports' a shipped cup into a
+    library (the real import of a mesh entry: tests/scenarios/test_scan_cup_run.py); the options
+    are the real ImportOptions."""
     calls = []
 
     def import_cached(source, options, *, cache_root=None):
@@ -156,9 +143,8 @@ def fake_importer(tmp_path, monkeypatch):
             copy_object("cup_01", "blue_mug", lib, category=options.category or "cup")
         return load_library(lib)["blue_mug"]
 
-    module = types.ModuleType("tg_drake.importing")
-    module.ImportOptions, module.import_cached = _FakeOptions, import_cached
-    monkeypatch.setitem(sys.modules, "tg_drake.importing", module)
+    import tg_drake.importing.library as library
+    monkeypatch.setattr(library, "import_cached", import_cached)
     return calls
 
 
