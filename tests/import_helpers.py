@@ -5,7 +5,6 @@ triangles added, optionally holes cut."""
 from __future__ import annotations
 
 import numpy as np
-import trimesh
 
 from tg_drake.objects import mesh
 
@@ -47,15 +46,3 @@ def read_obj(path):
     F = np.array([[t.split("/")[0] for t in ln.split()[1:4]] for ln in lines
                   if ln.startswith("f ")], np.int64) - 1
     return V, F
-
-
-def dense_scan_like(obj_id: str, *, n_triangles: int = 50_000, noise: float = 0.2, holes: int = 4,
-                    seed: int = 0):
-    """`scan_like`, subdivided (each triangle into four) to about `n_triangles` and its
-    vertices moved by Gaussian noise of `noise` mm (a scanner's), in mm, y up."""
-    V, F = scan_like(obj_id, holes=holes, seed=seed)
-    m = trimesh.Trimesh(V, F, process=False)
-    while 4 * len(m.faces) <= 1.2 * n_triangles:  # about n_triangles: within 20 % above
-        m = m.subdivide()
-    rng = np.random.default_rng(seed)
-    return np.asarray(m.vertices) + rng.normal(0.0, noise, m.vertices.shape), np.asarray(m.faces)

@@ -7,19 +7,18 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.import_helpers import dense_scan_like, write_obj
 from tg_drake.importing import ImportOptions, import_object
 from tg_drake.importing import mesh as M
 from tg_drake.importing.collision import BACKENDS
 from tg_drake.objects import get_object, mesh
+from tg_drake.scanlike import write_scanlike
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("backend", list(BACKENDS))
 def test_50k_scan_like_cup_imports(tmp_path, backend):
-    V, F = dense_scan_like("cup_01")
-    assert 40_000 < len(F) < 60_000
-    write_obj(tmp_path / "cup.obj", V, F)
+    scan = write_scanlike("cup_01", tmp_path / "cup.obj", seed=0)
+    assert 40_000 < len(scan.mesh.faces) < 60_000
     lib = get_object("cup_01")
     Vl, Fl, _ = mesh(lib)
     density = lib.mass / M.capped_moments(np.asarray(Vl), np.asarray(Fl))[0]
