@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import trimesh
 import yaml
 from scipy.spatial import cKDTree
 
@@ -127,10 +128,15 @@ def import_object(source: str | Path, options: ImportOptions, out_dir: Path, *,
     mp = mass_properties(V_O, F, watertight=repaired.watertight, category=options.category,
                          mass=options.mass, density=options.density, file=file)
     lap("mass")
-    poses = stable_poses(V_O, F, mp.com, is_tool=frame.kind == "tool")
-    lap("poses")
     pieces = collision.decompose(V_O, F, options.collision)
     lap("collision")
+    # The object rests in physics on its collision pieces: the resting poses are those of their
+    # convex hull (a piece's few vertices facet a round body: a pose from the full mesh would
+    # roll to the nearest facet), with the full mesh's centre of mass.
+    hull = trimesh.convex.convex_hull(np.vstack([p.vertices for p in pieces]))
+    poses = stable_poses(np.asarray(hull.vertices), np.asarray(hull.faces), mp.com,
+                         is_tool=frame.kind == "tool")
+    lap("poses")
     warnings = [*placement.warnings, *mp.warnings]
     if repaired.n_pieces > 1:
         warnings.append(f"{repaired.n_pieces} separate pieces: imported as one rigid object "
