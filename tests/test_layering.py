@@ -31,7 +31,7 @@ import pytest
 
 import tg_drake
 
-CORES = ("perception", "kernels", "logic", "grasping", "planning")
+CORES = ("perception", "kernels", "logic", "grasping", "planning", "importing")
 FORBIDDEN_IN_CORES = (
     "pydrake.systems",
     "tg_drake.station", "tg_drake.simulation", "tg_drake.systems",
