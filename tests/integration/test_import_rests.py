@@ -10,26 +10,18 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from pydrake.geometry import (
-    AddCompliantHydroelasticProperties,
-    AddContactMaterial,
-    Box,
-    ProximityProperties,
-)
 from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
-from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlantConfig
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from tests.import_helpers import scan_like, write_obj
+from tests.integration.test_objects_rest import X_WT, plant_with_rest_table
 from tg_drake.importing import ImportOptions, import_object
 
-TIME_STEP = 0.005  # [s] SAP, as the library objects' rest test
 DURATION = 2.0  # [s]
 MAX_DRIFT = 0.005  # [m] of the centre of mass (issue 18)
 MAX_TILT = np.radians(5.0)  # (issue 18)
-X_WT = RigidTransform([0.0, 0.0, 0.75])
 
 
 @pytest.fixture(scope="module")
@@ -45,16 +37,7 @@ def imported(tmp_path_factory):
 def rest(result, sdf, pose):
     obj = result.object
     builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlant(
-        MultibodyPlantConfig(time_step=TIME_STEP, contact_model="hydroelastic_with_fallback",
-                             discrete_contact_approximation="sap"), builder)
-    table = ProximityProperties()
-    AddCompliantHydroelasticProperties(resolution_hint=0.1, hydroelastic_modulus=1e7,
-                                       properties=table)
-    AddContactMaterial(dissipation=3.0, point_stiffness=None,
-                       friction=CoulombFriction(0.5, 0.5), properties=table)
-    plant.RegisterCollisionGeometry(plant.world_body(), X_WT @ RigidTransform([0, 0, -0.05]),
-                                    Box(1.0, 1.0, 0.1), "table", table)
+    plant = plant_with_rest_table(builder)
     Parser(plant).AddModels(str(sdf))
     plant.Finalize()
     simulator = Simulator(builder.Build())

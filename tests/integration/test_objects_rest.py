@@ -58,11 +58,9 @@ DEFAULT = list(FIRST_OF_CATEGORY.values())
 SLOW = [c for c in CASES if c not in DEFAULT]
 
 
-def rest_on_table(obj_id: str, pose: str) -> dict:
-    """Simulates the object resting on the table; returns what happened."""
-    obj = load_library()[obj_id]
-    t0 = time.perf_counter()
-    builder = DiagramBuilder()
+def plant_with_rest_table(builder: DiagramBuilder):
+    """A SAP plant (TIME_STEP) in `builder` with the rest table: a 1 m × 1 m × 0.1 m compliant
+    hydroelastic slab whose top face is the table-top frame T. Returns the plant, not finalized."""
     plant, _ = AddMultibodyPlant(
         MultibodyPlantConfig(time_step=TIME_STEP, contact_model="hydroelastic_with_fallback",
                              discrete_contact_approximation="sap"), builder)
@@ -71,10 +69,18 @@ def rest_on_table(obj_id: str, pose: str) -> dict:
                                        properties=table)
     AddContactMaterial(dissipation=3.0, point_stiffness=None,
                        friction=CoulombFriction(0.5, 0.5), properties=table)
-    # 1 m × 1 m × 0.1 m slab whose top face is the table-top frame T.
     plant.RegisterCollisionGeometry(plant.world_body(),
                                     X_WT @ RigidTransform([0.0, 0.0, -0.05]),
                                     Box(1.0, 1.0, 0.1), "table", table)
+    return plant
+
+
+def rest_on_table(obj_id: str, pose: str) -> dict:
+    """Simulates the object resting on the table; returns what happened."""
+    obj = load_library()[obj_id]
+    t0 = time.perf_counter()
+    builder = DiagramBuilder()
+    plant = plant_with_rest_table(builder)
     Parser(plant).AddModels(str(obj.sdf_path))
     plant.Finalize()
     diagram = builder.Build()
