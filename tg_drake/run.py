@@ -68,7 +68,10 @@ def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
     t_start = time.perf_counter()
     # The station and every stage, the supervisor included; Meshcat if asked for.
     builder = DiagramBuilder()
-    pipeline = add_pipeline(builder, scenario=scenario)
+    try:
+        pipeline = add_pipeline(builder, scenario=scenario)
+    except TgDrakeError as e:  # a field the build rejects (a camera's parent frame): the file too
+        raise _in_file(e, scenario_path) from None
     visualizer = None
     if meshcat is not None:
         from pydrake.geometry import MeshcatVisualizer
@@ -128,6 +131,13 @@ def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
     result = result_of(scenario=scenario, scenario_path=scenario_path, stages=stages,
                        outcome=outcome, plan_status=plan_status, timings=timings)
     return result, Pictures(stages, X_WG=plan_status.X_WG)
+
+
+def _in_file(error: TgDrakeError, scenario_path: str) -> TgDrakeError:
+    """`error` with the scenario file as its location, unless it names a file already."""
+    if error.file is not None or not scenario_path:
+        return error
+    return type(error)(error.message, file=scenario_path, line=error.line, field=error.field)
 
 
 def run_scenario(scenario, *, scenario_path: str = "", meshcat=None) -> dict:

@@ -1,6 +1,8 @@
 """Scenario fields the station honours: cameras through ApplyCameraConfig (renderer_class and
 renderer_name) and `table_size`."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -54,6 +56,18 @@ def test_conflicting_renderers_and_bad_ranges_name_the_camera():
     with pytest.raises(ScenarioError, match="clipping") as e:
         make_station(_scenario("cameras: {camera0: {z_near: 0.001}}"))
     assert e.value.field == "cameras.camera0"
+
+
+def test_a_camera_parent_frame_that_does_not_exist_names_the_file_and_the_camera(tmp_path):
+    from tg_drake.run import run_scenario
+    path = tmp_path / "camera_on_nothing.yaml"
+    path.write_text(Path("scenarios/default.yaml").read_text() + "\ncameras: {camera0: {X_PB: "
+                    "{base_frame: no_such_frame, translation: [1.5, 0.0, 0.5]}}}\n")
+    with pytest.raises(ScenarioError) as e:
+        run_scenario(load_scenario(path), scenario_path=str(path))
+    assert e.value.file == str(path)
+    assert e.value.field == "cameras.camera0"
+    assert "no_such_frame" in str(e.value)
 
 
 def test_the_key_names_the_camera_and_its_ports():
