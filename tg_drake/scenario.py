@@ -648,6 +648,7 @@ def _import_mesh(placement: ObjectPlacement, path: Path, labels: Path | None, wh
                  f: str):
     """The object imported from `path` (tg_drake.importing, cached), registered."""
     from tg_drake.importing import ImportOptions, import_cached  # the import is heavy and rare
+    from tg_drake.importing.library import unclaimed_id
 
     options = dict(category=placement.category or None, units=placement.units,
                    up_axis=placement.up_axis, mass=placement.mass, density=placement.density,
@@ -655,7 +656,7 @@ def _import_mesh(placement: ObjectPlacement, path: Path, labels: Path | None, wh
     if placement.collision:
         options["collision"] = placement.collision
     try:
-        return register_object(import_cached(path, ImportOptions(**options)))
+        return register_object(import_cached(path, unclaimed_id(path, ImportOptions(**options))))
     except (ScenarioError, ModelError) as e:
         field = e.field if e.field in MESH_FIELDS else "mesh"
         raise ScenarioError(e.message + (f" ({e.file})" if e.file else ""), file=where,

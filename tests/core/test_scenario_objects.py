@@ -188,3 +188,29 @@ def test_a_dumped_scenario_loads_again(tmp_path):
     again = _write(tmp_path / "again", text)
     scenario = load_scenario(again)  # every default written out: pose with resting null, ...
     assert scenario.objects[0].id == "my_mug" and scenario.objects[0].xy == [0, 0.1]
+
+
+def test_one_mesh_imported_with_other_options_and_a_library_name_get_their_own_ids(
+        tmp_path, monkeypatch):
+    import trimesh
+    monkeypatch.setenv("TG_DRAKE_CACHE", str(tmp_path / "cache"))
+    trimesh.creation.box([0.08, 0.05, 0.12]).export(tmp_path / "carton.stl")
+    trimesh.creation.box([0.06, 0.06, 0.10]).export(tmp_path / "cup_01.stl")
+    path = _write(tmp_path, "objects:\n"
+                            "  - {mesh: carton.stl, units: m, mass: 0.2, collision: vhacd,"
+                            " resting: auto}\n"
+                            "  - {mesh: carton.stl, units: m, mass: 0.5, collision: vhacd,"
+                            " name: heavy, xy: [0.2, 0], resting: auto}\n"
+                            "  - {mesh: cup_01.stl, units: m, collision: vhacd, xy: [-0.2, 0],"
+                            " resting: auto}\n")
+    scenario = load_scenario(path)
+    light, heavy, named = scenario.objects
+    assert light.id == "carton"
+    assert heavy.id.startswith("carton_") and len(heavy.id) == len("carton_") + 6
+    assert named.id.startswith("cup_01_")
+    assert get_object(light.id).mass == pytest.approx(0.2)
+    assert get_object(heavy.id).mass == pytest.approx(0.5)
+    assert get_object("cup_01").category == "cup"  # the shipped cup is untouched
+    from tg_drake.scenario import validate
+    validate(scenario)  # the station resolves the objects again: the same ids
+    assert [p.id for p in scenario.objects] == [light.id, heavy.id, named.id]

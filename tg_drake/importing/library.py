@@ -355,6 +355,29 @@ def cache_key(source: str | Path, options: ImportOptions) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
+def unclaimed_id(source: str | Path, options: ImportOptions, *,
+                 cache_root: Path | None = None) -> ImportOptions:
+    """`options` with an object id no other known object holds. Without an `obj_id` the id is
+    the file's (or folder's) name; when the shipped library or a registered object already holds
+    that name for another object (the same file imported with other options, or a mesh named like
+    a library object), the name is followed by the first 6 hex digits of this import's cache key,
+    which is the same on every call."""
+    if options.obj_id is not None:
+        return options
+    name = resolve(source).name
+    try:
+        holder = objects.get_object(name)
+    except ModelError:
+        raise
+    except ValueError:  # unknown: the name is free
+        return options
+    root = Path(cache_root) if cache_root is not None else default_cache_root()
+    key = cache_key(source, options)
+    if holder.root is not None and holder.root.resolve() == (root / key).resolve():
+        return options  # this very import, registered before
+    return dataclasses.replace(options, obj_id=f"{name}_{key[:6]}")
+
+
 def import_cached(source: str | Path, options: ImportOptions, *,
                   cache_root: Path | None = None) -> objects.LibraryObject:
     """The imported object, from the cache folder of its content hash; imports it (once, without
