@@ -25,6 +25,7 @@ COMMANDS: dict[str, str] = {
     "run": "tg_drake.run",
     "eval": "tg_drake.evaluation.cli",
     "import-object": "tg_drake.importing.cli",
+    "cache": "tg_drake.importing.cache",
 }
 
 # command → its options that name a path it writes, and whether each is a "folder" or a "file".

@@ -33,7 +33,8 @@ from scipy.spatial import cKDTree
 
 from tg_drake import objects
 from tg_drake.errors import ModelError, unknown_name
-from tg_drake.importing import collision, report
+from tg_drake.importing import cache, collision, report
+from tg_drake.importing.cache import default_cache_root
 from tg_drake.importing.frame import derive_frame
 from tg_drake.importing.mass import mass_properties
 from tg_drake.importing.mesh import UNITS, UP_AXES, load, repair, to_metres_z_up
@@ -337,12 +338,6 @@ def load_object(library_dir: Path, obj_id: str) -> objects.LibraryObject:
 # cache
 
 
-def default_cache_root() -> Path:
-    """$TG_DRAKE_CACHE, else ~/.cache/tg_drake/objects."""
-    env = os.environ.get("TG_DRAKE_CACHE")
-    return Path(env) if env else Path.home() / ".cache" / "tg_drake" / "objects"
-
-
 def cache_key(source: str | Path, options: ImportOptions) -> str:
     """Content hash of the source files and the options (a label file by its content)."""
     src = resolve(source)
@@ -387,6 +382,7 @@ def import_cached(source: str | Path, options: ImportOptions, *,
     folder = root / cache_key(source, options)
     obj_id = options.obj_id or resolve(source).name
     if (folder / "library.yaml").is_file():
+        cache.touch(folder)
         return load_object(folder, obj_id)
     root.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=".import-", dir=root))
