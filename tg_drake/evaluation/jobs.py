@@ -11,7 +11,8 @@ table can be derived again from the records (tg_drake.evaluation.tables).
   task (inferred) and, for each ground-truth task given, the pre-grasp part.
 - perceived: the object's depth image ray cast from the default camera's viewpoint and perceived;
   pose and part detection against the truth; then the same queries on observations of each setting.
-- executed: `tg_drake.run.run_scenario` on the scenario in the case's variant.
+- executed: `tg_drake.run.run_scenario` on the scenario in the case's variant; `build_s` is the
+  wall time of building its diagram and context [s] (the executor adds `worker_pid` and `rss_mb`).
 """
 
 from __future__ import annotations
@@ -204,7 +205,8 @@ def run_executed(case) -> dict:
     result = run_scenario(scenario, scenario_path=case.key)
     keep = ("perception", "category_prior", "category", "task", "part", "grasp",
             "grasp_probability", "n_hypotheses", "planning", "outcome", "timings")
-    return {**case.meta(), **{k: result[k] for k in keep if k in result}}
+    return {**case.meta(), **{k: result[k] for k in keep if k in result},
+            "build_s": round(result["timings"]["build"], 3)}
 
 
 def run_case(case) -> dict | list[dict]:
