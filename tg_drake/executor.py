@@ -16,8 +16,8 @@ One interface for every sweep (grasp-data collection, scenario evaluation):
   in flight one at a time, and is recorded with the reason "worker process died". Neither stops
   the sweep. The records of a job that ran more than once (its worker died under it) carry
   "attempts": the number of times it was started.
-- Every record says where it ran: `worker_pid` and `rss_mb` (the worker's peak resident memory so
-  far [MB]). What a job writes besides its result — Python warnings, log records (Drake's C++ log
+- Every record says where and how long it ran: `worker_pid`, `rss_mb` (the worker's peak resident
+  memory so far [MB]) and `wall_s` (the job's wall time [s]). What a job writes besides its result — Python warnings, log records (Drake's C++ log
   lines reach Python's `logging`), and, in a pool or Ray worker, anything written to its stdout or
   stderr by native code — is captured per job and kept in the record's "log" (a list of lines);
   with the progress bar, each distinct line is also printed above the bar (tqdm.write), so the
@@ -97,6 +97,7 @@ class Outcome:
     log: tuple[str, ...] = ()  # what the job wrote besides its result (warnings, log lines)
     worker_pid: int | None = None  # the process that ran it (None: its worker died)
     rss_mb: float | None = None  # that process's peak resident memory so far [MB]
+    wall_s: float | None = None  # wall time of the job's function [s]
 
 
 @dataclass
@@ -115,6 +116,7 @@ def call_job(fn: Callable[[Any], Any], payload: Any, capture_fds: bool = False) 
     file read back after each job (a worker's; never the process that draws the progress bar)."""
     if capture_fds:
         capture_output()
+    t0 = time.perf_counter()
     with JobLog() as log:
         try:
             result = fn(payload)
@@ -127,7 +129,8 @@ def call_job(fn: Callable[[Any], Any], payload: Any, capture_fds: bool = False) 
             outcome = Outcome(records) if all(isinstance(r, dict) for r in records) else Outcome(
                 None, f"job returned {type(result).__name__}, not a dict or list of dicts")
     return dataclasses.replace(outcome, log=log.lines, worker_pid=os.getpid(),
-                               rss_mb=peak_rss_mb())
+                               rss_mb=peak_rss_mb(),
+                               wall_s=round(time.perf_counter() - t0, 3))
 
 
 def peak_rss_mb() -> float | None:
@@ -631,7 +634,8 @@ def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, execut
                 records = outcome.records
                 label = outcome_of(records) if outcome_of is not None else "done"
             where = {k: v for k, v in (("worker_pid", outcome.worker_pid),
-                                       ("rss_mb", outcome.rss_mb)) if v is not None}
+                                       ("rss_mb", outcome.rss_mb),
+                                       ("wall_s", outcome.wall_s)) if v is not None}
             if outcome.log:
                 where["log"] = list(outcome.log)
             if outcome.attempts > 1:

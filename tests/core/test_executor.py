@@ -49,7 +49,7 @@ def read(path):
     return [json.loads(line) for line in path.read_text().splitlines()]
 
 
-WHERE = ("worker_pid", "rss_mb")  # where a job ran: in every record the executor writes
+WHERE = ("worker_pid", "rss_mb", "wall_s")  # where a job ran: in every record the executor writes
 
 
 def core(record):
@@ -71,7 +71,7 @@ def test_results_stream_to_jsonl_and_a_rerun_skips_them(tmp_path, pool):
     assert sorted((r["job"], r["x"], r["y"]) for r in rows) == [
         (f"j{x // 2}", x, x * x) for x in range(8)]
     assert os.getpid() not in {r["pid"] for r in rows}  # ran in worker processes, not here
-    assert all(r["worker_pid"] == r["pid"] and r["rss_mb"] > 1 for r in rows)
+    assert all(r["worker_pid"] == r["pid"] and r["rss_mb"] > 1 and r["wall_s"] >= 0 for r in rows)
 
     summary = run_jobs(square, jobs, out=out, executor=pool, progress=False)
     assert (summary.n_ran, summary.n_skipped, summary.n_records) == (2, 4, 4)

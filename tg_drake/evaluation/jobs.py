@@ -193,7 +193,8 @@ def run_perceived(case) -> list[dict]:
     return records
 
 
-def run_executed(case) -> dict:
+def scenario_of(case) -> Scenario:
+    """The scenario an executed case runs (validated)."""
     pipeline = PipelineConfig(scoring=LocalOnly() if case.variant == "local" else DgiScorer())
     pipeline.logic.category = pipeline.logic.grasp = case.theory
     pipeline.logic.use_prior = case.variant != "pipeline_uniform"
@@ -202,7 +203,11 @@ def run_executed(case) -> dict:
                                         place_xy=list(case.place_xy)),
                         object_libraries=list(case.object_libraries))
     validate(scenario, where=case.key)
-    result = run_scenario(scenario, scenario_path=case.key)
+    return scenario
+
+
+def run_executed(case) -> dict:
+    result = run_scenario(scenario_of(case), scenario_path=case.key)
     keep = ("perception", "category_prior", "category", "task", "part", "grasp",
             "grasp_probability", "n_hypotheses", "planning", "outcome", "timings")
     return {**case.meta(), **{k: result[k] for k in keep if k in result},
