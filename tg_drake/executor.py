@@ -25,8 +25,9 @@ One interface for every sweep (grasp-data collection, scenario evaluation):
 - The progress bar shows the ETA and, with `outcome_of` (records → a word), counts per word as
   jobs finish ("placed=3 failed=1 error=1").
 
-`LocalExecutor` is a process pool (spawned workers, which die with the process that started them;
-`workers=0` runs in this process, for debugging). `RayExecutor` submits to a Ray cluster, or
+`LocalExecutor` is a process pool (spawned workers, which die with the process that started them,
+each with its share of the cores for its libraries' thread pools; `workers=0` runs in this process,
+for debugging). `RayExecutor` submits to a Ray cluster, or
 starts a local Ray instance of its own (its own temp folder); an address is checked (its form, then
 a connection) before Ray is started. Ray is an optional dependency (`pip install 'tg_drake[ray]'`)
 and is imported only when that executor is made.
@@ -70,6 +71,11 @@ EXECUTORS = ("local", "ray")
 WORKER_DIED = "worker process died"
 RAY_ATTEMPTS = 3  # times a Ray job is started when its worker or node dies under it
 RAY_CONNECT_TIMEOUT_S = 3.0  # s, for the probe of a Ray cluster's address
+# Thread pools of the numeric libraries (OpenMP: Open3D, VTK; BLAS: numpy, scikit-learn), sized in
+# each pool worker to its share of the cores unless the user set them: workers that each start a
+# thread per core wait on one another.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                    "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
 PARENT_POLL_S = 0.5  # s, between a worker's checks that its parent lives (where prctl is missing)
 NO_ANSWER = f"no answer within {RAY_CONNECT_TIMEOUT_S:g} s"
 MAX_QUOTED = 120  # characters of a bad line quoted in an error
@@ -239,9 +245,10 @@ class LocalExecutor(Executor):
         self.max_tasks_per_child = max_tasks_per_child  # recycle workers that leak memory
 
     def _pool(self) -> ProcessPoolExecutor:
+        threads = max(1, (os.cpu_count() or 1) // self.workers)
         pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
                                    max_tasks_per_child=self.max_tasks_per_child,
-                                   initializer=start_worker, initargs=(os.getpid(),))
+                                   initializer=start_worker, initargs=(os.getpid(), threads))
         # Start every worker with the pool: one spawned on demand, as the pool's watcher thread
         # has begun to wait, is not watched, and its death (a job that kills it while the other
         # jobs run on) would leave the sweep waiting forever.
@@ -297,10 +304,14 @@ class LocalExecutor(Executor):
                 pool.shutdown(wait=True, cancel_futures=True)
 
 
-def start_worker(parent_pid: int) -> None:
-    """A pool worker's initializer: it dies with its parent, and its output is captured per job
-    (so that it never writes over the parent's progress bar)."""
+def start_worker(parent_pid: int, threads: int = 1) -> None:
+    """A pool worker's initializer: it dies with its parent, its output is captured per job (so
+    that it never writes over the parent's progress bar), and its numeric libraries' thread pools
+    get `threads` threads (its share of the cores; THREAD_VARIABLES the user set are kept). Runs
+    before the job's modules, and so numpy and Open3D, are imported."""
     die_with_parent(parent_pid)
+    for name in THREAD_VARIABLES:
+        os.environ.setdefault(name, str(threads))
     capture_output()
 
 

@@ -432,3 +432,20 @@ def test_a_job_in_this_process_keeps_its_warnings_in_its_record(tmp_path, capfd)
     err = capfd.readouterr().err
     assert "degenerate" not in err and "penetration" not in err  # not on stderr: in the record
     assert record["worker_pid"] == os.getpid()
+
+
+def thread_settings(_):
+    from tg_drake.executor import THREAD_VARIABLES
+
+    return {name: os.environ.get(name) for name in THREAD_VARIABLES}
+
+
+def test_pool_workers_get_their_share_of_the_cores_for_thread_pools(tmp_path, monkeypatch):
+    monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "3")  # the user's setting is kept
+    out = tmp_path / "r.jsonl"
+    run_jobs(thread_settings, [Job("a", None)], out=out, executor=LocalExecutor(workers=2),
+             progress=False)
+    (record,) = read(out)
+    assert record["OMP_NUM_THREADS"] == str(max(1, (os.cpu_count() or 1) // 2))
+    assert record["OPENBLAS_NUM_THREADS"] == "3"
