@@ -666,6 +666,8 @@ def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, execut
                 bar.set_postfix_str(" ".join(f"{k}={v}" for k, v in counts.items()),
                                     refresh=False)
                 bar.update(1)
+                if bar.n == bar.total:  # its rate and time as the last job finished
+                    bar.close()
     if bar is not None:
         bar.close()
     summary.counts = counts
