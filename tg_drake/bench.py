@@ -27,6 +27,8 @@ FIGURES: dict[str, str] = {
     "segmentation_ms": "tg_drake.perception.bench:segmentation_ms",
     "dgi_us_per_hypothesis": "tg_drake.grasping.bench:dgi_us_per_hypothesis",
     "sweep_efficiency": "tg_drake.evaluation.bench:sweep_efficiency",
+    "suite_case_s": "tg_drake.evaluation.bench:suite_case_s",
+    "worker_rss_mb": "tg_drake.evaluation.bench:worker_rss_mb",
     "pipeline_rtf": "tg_drake.run:bench_pipeline_rtf",
     "import_s": "tg_drake.importing.bench:import_s",
     "scan_run_ratio": "tg_drake.run:bench_scan_run_ratio",

@@ -16,9 +16,18 @@ One interface for every sweep (grasp-data collection, scenario evaluation):
   in flight one at a time, and is recorded with the reason "worker process died". Neither stops
   the sweep. The records of a job that ran more than once (its worker died under it) carry
   "attempts": the number of times it was started.
+- Every record says where and how long it ran: `worker_pid`, `rss_mb` (the worker's peak resident
+  memory so far [MB]) and `wall_s` (the job's wall time [s]). What a job writes besides its result — Python warnings, log records (Drake's C++ log
+  lines reach Python's `logging`), and, in a pool or Ray worker, anything written to its stdout or
+  stderr by native code — is captured per job and kept in the record's "log" (a list of lines);
+  with the progress bar, each distinct line is also printed above the bar (tqdm.write), so the
+  bar's lines stay intact.
+- The progress bar shows the ETA and, with `outcome_of` (records → a word), counts per word as
+  jobs finish ("placed=3 failed=1 error=1").
 
-`LocalExecutor` is a process pool (spawned workers, which die with the process that started them;
-`workers=0` runs in this process, for debugging). `RayExecutor` submits to a Ray cluster, or
+`LocalExecutor` is a process pool (spawned workers, which die with the process that started them,
+each with its share of the cores for its libraries' thread pools; `workers=0` runs in this process,
+for debugging). `RayExecutor` submits to a Ray cluster, or
 starts a local Ray instance of its own (its own temp folder); an address is checked (its form, then
 a connection) before Ray is started. Ray is an optional dependency (`pip install 'tg_drake[ray]'`)
 and is imported only when that executor is made.
@@ -29,6 +38,7 @@ from __future__ import annotations
 import ctypes
 import dataclasses
 import json
+import logging
 import multiprocessing
 import os
 import shutil
@@ -39,6 +49,7 @@ import tempfile
 import threading
 import time
 import traceback
+import warnings
 from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
@@ -51,13 +62,27 @@ from typing import Any
 from tg_drake.errors import OutputError, TgDrakeError, unknown_name
 from tg_drake.outputs import check_output_file
 
+try:
+    import resource  # POSIX only: the workers' peak memory
+except ImportError:
+    resource = None
+
 EXECUTORS = ("local", "ray")
 WORKER_DIED = "worker process died"
 RAY_ATTEMPTS = 3  # times a Ray job is started when its worker or node dies under it
 RAY_CONNECT_TIMEOUT_S = 3.0  # s, for the probe of a Ray cluster's address
+# Thread pools of the numeric libraries (OpenMP: Open3D, VTK; BLAS: numpy, scikit-learn), sized in
+# each pool worker to its share of the cores unless the user set them: workers that each start a
+# thread per core wait on one another.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                    "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
 PARENT_POLL_S = 0.5  # s, between a worker's checks that its parent lives (where prctl is missing)
 NO_ANSWER = f"no answer within {RAY_CONNECT_TIMEOUT_S:g} s"
 MAX_QUOTED = 120  # characters of a bad line quoted in an error
+MAX_LOG_LINES = 20  # lines of a job's captured output kept in its record
+MAX_LOG_CHARS = 300  # characters of one captured line kept
+BAR_FORMAT = ("{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} "
+              "[{elapsed}, ETA {remaining}, {rate_fmt}{postfix}]")
 
 
 @dataclass(frozen=True)
@@ -75,6 +100,10 @@ class Outcome:
     records: list[dict] | None
     error: str | None = None
     attempts: int = 1  # times the job was started (> 1: its worker died under an earlier one)
+    log: tuple[str, ...] = ()  # what the job wrote besides its result (warnings, log lines)
+    worker_pid: int | None = None  # the process that ran it (None: its worker died)
+    rss_mb: float | None = None  # that process's peak resident memory so far [MB]
+    wall_s: float | None = None  # wall time of the job's function [s]
 
 
 @dataclass
@@ -84,20 +113,115 @@ class RunSummary:
     n_ran: int  # run now
     n_errors: int  # of those run now, jobs recorded as errors
     n_records: int  # lines written now
+    counts: dict[str, int] = dataclasses.field(default_factory=dict)  # jobs run now per outcome
 
 
-def call_job(fn: Callable[[Any], Any], payload: Any) -> Outcome:
-    """Runs `fn(payload)` and turns its result or exception into an Outcome (runs in a worker)."""
-    try:
-        result = fn(payload)
-    except Exception as e:  # noqa: BLE001 - every failure of a job is data, not a crash.
-        last = traceback.extract_tb(e.__traceback__)[-1]
-        where = f" ({os.path.basename(last.filename)}:{last.lineno})" if last else ""
-        return Outcome(None, f"{type(e).__name__}: {e}{where}")
-    records = result if isinstance(result, list) else [result]
-    if not all(isinstance(r, dict) for r in records):
-        return Outcome(None, f"job returned {type(result).__name__}, not a dict or list of dicts")
-    return Outcome(records)
+def call_job(fn: Callable[[Any], Any], payload: Any, capture_fds: bool = False) -> Outcome:
+    """Runs `fn(payload)` and turns its result or exception into an Outcome (runs in a worker),
+    with what it wrote besides (JobLog). `capture_fds`: this process's stdout and stderr go to a
+    file read back after each job (a worker's; never the process that draws the progress bar)."""
+    if capture_fds:
+        capture_output()
+    t0 = time.perf_counter()
+    with JobLog() as log:
+        try:
+            result = fn(payload)
+        except Exception as e:  # noqa: BLE001 - every failure of a job is data, not a crash.
+            last = traceback.extract_tb(e.__traceback__)[-1]
+            where = f" ({os.path.basename(last.filename)}:{last.lineno})" if last else ""
+            outcome = Outcome(None, f"{type(e).__name__}: {e}{where}")
+        else:
+            records = result if isinstance(result, list) else [result]
+            outcome = Outcome(records) if all(isinstance(r, dict) for r in records) else Outcome(
+                None, f"job returned {type(result).__name__}, not a dict or list of dicts")
+    return dataclasses.replace(outcome, log=log.lines, worker_pid=os.getpid(),
+                               rss_mb=peak_rss_mb(),
+                               wall_s=round(time.perf_counter() - t0, 3))
+
+
+def peak_rss_mb() -> float | None:
+    """This process's peak resident memory so far [MB] (None where `resource` is missing)."""
+    if resource is None:
+        return None
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux, bytes on macOS
+    return round(peak / (2**20 if sys.platform == "darwin" else 2**10), 1)
+
+
+_CAPTURED: Any = None  # in a worker: the file its stdout and stderr (fds 1, 2) are sent to
+
+
+def capture_output() -> None:
+    """Sends this process's stdout and stderr (fds 1 and 2: Python's and native code's writes)
+    to an unnamed temporary file, read back by JobLog after each job. Once per process."""
+    global _CAPTURED
+    if _CAPTURED is not None:
+        return
+    for stream in (sys.stdout, sys.stderr):
+        if stream is not None:
+            stream.flush()
+    f = tempfile.TemporaryFile()
+    os.dup2(f.fileno(), 1)
+    os.dup2(f.fileno(), 2)
+    _CAPTURED = f
+
+
+def _take_captured() -> list[str]:
+    """The lines written to the captured fds since the last call; the file is emptied."""
+    if _CAPTURED is None:
+        return []
+    for stream in (sys.stdout, sys.stderr):
+        if stream is not None:
+            stream.flush()
+    fd = _CAPTURED.fileno()
+    size = os.fstat(fd).st_size
+    data = os.pread(fd, size, 0) if size else b""
+    os.ftruncate(fd, 0)
+    os.lseek(fd, 0, os.SEEK_SET)  # shared by fds 1 and 2: the next write starts at 0
+    return data.decode("utf-8", "replace").splitlines()
+
+
+class _LogHandler(logging.Handler):
+    def __init__(self, lines: list[str]):
+        super().__init__(logging.WARNING)
+        self._lines = lines
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            self._lines.append(f"[{record.name}] {record.levelname}: {record.getMessage()}")
+        except Exception:  # noqa: BLE001 - a bad log call must not fail the job
+            self.handleError(record)
+
+
+class JobLog:
+    """Collects what a job writes besides its result: Python warnings (shown as they would be,
+    once per place under the default filters), log records of level WARNING and above (Drake's C++
+    log lines come through Python's `logging`; while a job runs they reach this collector rather
+    than the last-resort handler on stderr), and the lines of the captured fds (capture_output).
+    `lines`: at most MAX_LOG_LINES, each at most MAX_LOG_CHARS."""
+
+    def __enter__(self) -> JobLog:
+        self._lines: list[str] = []
+        self._warnings = warnings.catch_warnings(record=True)
+        self._caught = self._warnings.__enter__()
+        self._handler = _LogHandler(self._lines)
+        logging.getLogger().addHandler(self._handler)
+        _take_captured()  # what was written between jobs is not this job's
+        self.lines: tuple[str, ...] = ()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        logging.getLogger().removeHandler(self._handler)
+        self._warnings.__exit__(*exc)
+        lines = [f"{w.category.__name__}: {w.message} ({os.path.basename(w.filename)}:"
+                 f"{w.lineno})" for w in self._caught]
+        lines += self._lines + _take_captured()
+        lines = [" ".join(line.split()) for line in lines]
+        lines = [line if len(line) <= MAX_LOG_CHARS else line[:MAX_LOG_CHARS] + "…"
+                 for line in lines if line]
+        if len(lines) > MAX_LOG_LINES:
+            lines = lines[:MAX_LOG_LINES - 1] + [f"… ({len(lines) - MAX_LOG_LINES + 1} more "
+                                                 "lines)"]
+        self.lines = tuple(lines)
 
 
 class Executor(ABC):
@@ -121,9 +245,10 @@ class LocalExecutor(Executor):
         self.max_tasks_per_child = max_tasks_per_child  # recycle workers that leak memory
 
     def _pool(self) -> ProcessPoolExecutor:
+        threads = max(1, (os.cpu_count() or 1) // self.workers)
         pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
                                    max_tasks_per_child=self.max_tasks_per_child,
-                                   initializer=die_with_parent, initargs=(os.getpid(),))
+                                   initializer=start_worker, initargs=(os.getpid(), threads))
         # Start every worker with the pool: one spawned on demand, as the pool's watcher thread
         # has begun to wait, is not watched, and its death (a job that kills it while the other
         # jobs run on) would leave the sweep waiting forever.
@@ -177,6 +302,17 @@ class LocalExecutor(Executor):
                     suspects.extend(in_flight.values())
             finally:
                 pool.shutdown(wait=True, cancel_futures=True)
+
+
+def start_worker(parent_pid: int, threads: int = 1) -> None:
+    """A pool worker's initializer: it dies with its parent, its output is captured per job (so
+    that it never writes over the parent's progress bar), and its numeric libraries' thread pools
+    get `threads` threads (its share of the cores; THREAD_VARIABLES the user set are kept). Runs
+    before the job's modules, and so numpy and Open3D, are imported."""
+    die_with_parent(parent_pid)
+    for name in THREAD_VARIABLES:
+        os.environ.setdefault(name, str(threads))
+    capture_output()
 
 
 def die_with_parent(parent_pid: int) -> None:
@@ -276,7 +412,7 @@ class RayExecutor(Executor):
             while pending and len(in_flight) < self.max_in_flight:
                 job = pending.popleft()
                 attempts[job.key] = attempts.get(job.key, 0) + 1
-                in_flight[remote.remote(fn_ref, job.payload)] = job
+                in_flight[remote.remote(fn_ref, job.payload, True)] = job
             (ready,), _ = ray.wait(list(in_flight), num_returns=1)
             job = in_flight.pop(ready)
             try:
@@ -463,10 +599,13 @@ def finished_jobs(out: Path, *, retry_errors: bool = False) -> set[str]:
 
 
 def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, executor: Executor,
-             retry_errors: bool = False, progress: bool = True) -> RunSummary:
+             retry_errors: bool = False, progress: bool = True,
+             outcome_of: Callable[[list[dict]], str] | None = None) -> RunSummary:
     """Runs the jobs not yet in `out` and appends their records to it as they finish.
 
     `fn` must be importable by name (a module-level function) for process and Ray executors.
+    `outcome_of(records)` names a finished job's outcome for the progress bar's counts (default
+    "done"; a job recorded as an error counts as "error").
     """
     jobs = list(jobs)
     keys = [job.key for job in jobs]
@@ -485,7 +624,11 @@ def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, execut
     if progress:
         from tqdm import tqdm  # start-up: this module is on `tg-drake --help`'s path; tqdm ~0.5 s
 
-        bar = tqdm(total=len(todo), desc=out.name, unit="job")
+        # smoothing 0: the ETA from the mean time per job so far (jobs differ tenfold in cost).
+        bar = tqdm(total=len(todo), desc=out.name, unit="job", bar_format=BAR_FORMAT,
+                   smoothing=0.0)
+    counts: dict[str, int] = {}
+    shown: set[str] = set()  # log lines already printed above the bar
     with out.open("a") as f:
         # A last record without its newline (an edited file): start on a fresh line.
         if f.tell() > 0:
@@ -497,17 +640,35 @@ def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, execut
             if outcome.error is not None:
                 records = [{"status": "error", "reason": outcome.error}]
                 summary.n_errors += 1
+                label = "error"
             else:
                 records = outcome.records
+                label = outcome_of(records) if outcome_of is not None else "done"
+            where = {k: v for k, v in (("worker_pid", outcome.worker_pid),
+                                       ("rss_mb", outcome.rss_mb),
+                                       ("wall_s", outcome.wall_s)) if v is not None}
+            if outcome.log:
+                where["log"] = list(outcome.log)
             if outcome.attempts > 1:
-                records = [{**r, "attempts": outcome.attempts} for r in records]
+                where["attempts"] = outcome.attempts
+            records = [{**r, **where} for r in records]
             # One write per job: its lines land together.
             f.write("".join(json.dumps({"job": job.key, **r}) + "\n" for r in records))
             f.flush()
             summary.n_ran += 1
             summary.n_records += len(records)
+            counts[label] = counts.get(label, 0) + 1
             if bar is not None:
+                for line in outcome.log:
+                    if line not in shown:  # each distinct line once, above the bar
+                        shown.add(line)
+                        bar.write(f"{job.key}: {line}", file=sys.stderr)
+                bar.set_postfix_str(" ".join(f"{k}={v}" for k, v in counts.items()),
+                                    refresh=False)
                 bar.update(1)
+                if bar.n == bar.total:  # its rate and time as the last job finished
+                    bar.close()
     if bar is not None:
         bar.close()
+    summary.counts = counts
     return summary

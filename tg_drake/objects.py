@@ -50,6 +50,8 @@ import yaml
 from tg_drake.errors import ModelError, ScenarioError, unknown_name
 from tg_drake.types import CATEGORIES, PART_LABELS, POSES
 
+SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's: ~10× faster, same data
+
 HELP = "list the object library (id, category, size, mass, parts)"
 
 PACKAGE = "tg_drake_models"
@@ -264,7 +266,7 @@ def _load_shipped() -> MappingProxyType:
         raise ModelError("object library missing; run `python tools/make_objects.py`",
                          file=str(path))
     with open(path) as f:
-        data = yaml.safe_load(f)
+        data = yaml.load(f, Loader=SAFE_LOADER)
     try:
         objects = {k: _object(k, v, shipped_root()) for k, v in data["objects"].items()}
     except (KeyError, TypeError) as e:
@@ -286,7 +288,7 @@ def _load_folder(root: Path, version) -> MappingProxyType:
         raise ModelError("not an object library: it has no library.yaml (`tg-drake "
                          "import-object --out DIR` writes one)", file=str(path))
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        data = yaml.load(path.read_text(encoding="utf-8"), Loader=SAFE_LOADER)
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
         raise ModelError(f"cannot read the object library: {' '.join(str(e).split())}",
                          file=str(path)) from None

@@ -3,6 +3,7 @@
 import importlib.util
 import json
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -48,6 +49,14 @@ def read(path):
     return [json.loads(line) for line in path.read_text().splitlines()]
 
 
+WHERE = ("worker_pid", "rss_mb", "wall_s")  # where a job ran: in every record the executor writes
+
+
+def core(record):
+    """A record without where it ran."""
+    return {k: v for k, v in record.items() if k not in WHERE}
+
+
 @pytest.fixture(scope="module")
 def pool():
     return LocalExecutor(workers=2)
@@ -62,6 +71,7 @@ def test_results_stream_to_jsonl_and_a_rerun_skips_them(tmp_path, pool):
     assert sorted((r["job"], r["x"], r["y"]) for r in rows) == [
         (f"j{x // 2}", x, x * x) for x in range(8)]
     assert os.getpid() not in {r["pid"] for r in rows}  # ran in worker processes, not here
+    assert all(r["worker_pid"] == r["pid"] and r["rss_mb"] > 1 and r["wall_s"] >= 0 for r in rows)
 
     summary = run_jobs(square, jobs, out=out, executor=pool, progress=False)
     assert (summary.n_ran, summary.n_skipped, summary.n_records) == (2, 4, 4)
@@ -88,7 +98,7 @@ def test_a_job_that_kills_its_worker_is_found_and_recorded(tmp_path, pool):
     summary = run_jobs(square, jobs, out=out, executor=pool, progress=False)
     by_job = {r["job"]: r for r in read(out)}
     assert set(by_job) == {f"ok{i}" for i in range(5)} | {"die", "last"}
-    died = {k: v for k, v in by_job["die"].items() if k != "attempts"}  # alone or with others
+    died = {k: v for k, v in core(by_job["die"]).items() if k != "attempts"}  # alone or with others
     assert died == {"job": "die", "status": "error", "reason": WORKER_DIED}
     assert [by_job[f"ok{i}"]["y"] for i in range(5)] == [0, 1, 4, 9, 16]
     assert summary.n_errors == 1 and summary.n_ran == 7
@@ -102,7 +112,7 @@ def test_a_torn_last_line_is_ignored_and_rerun(tmp_path):
                        executor=LocalExecutor(workers=0), progress=False)
     assert summary.n_ran == 1
     lines = out.read_text().splitlines()
-    assert json.loads(lines[-1]) == {"job": "b", "x": 3, "y": 9, "pid": os.getpid()}
+    assert core(json.loads(lines[-1])) == {"job": "b", "x": 3, "y": 9, "pid": os.getpid()}
     assert len(lines) == 2  # the torn line was cut off, not left in the file
 
 
@@ -172,8 +182,8 @@ def test_jobs_rerun_after_their_worker_died_record_their_attempts(tmp_path, pool
     jobs = [Job(role, {"role": role, "folder": str(tmp_path)}) for role in ("wait", "die")]
     summary = run_jobs(square, jobs, out=out, executor=pool, progress=False)
     by_job = {r["job"]: r for r in read(out)}
-    assert by_job["wait"] == {"job": "wait", "waited": True, "attempts": 2}
-    assert by_job["die"] == {"job": "die", "status": "error", "reason": WORKER_DIED,
+    assert core(by_job["wait"]) == {"job": "wait", "waited": True, "attempts": 2}
+    assert core(by_job["die"]) == {"job": "die", "status": "error", "reason": WORKER_DIED,
                              "attempts": 2}
     assert summary.n_errors == 1
 
@@ -353,9 +363,89 @@ def test_a_local_ray_instance_is_the_sweeps_own_and_counts_attempts(tmp_path, mo
     for r in read(out):
         by_job.setdefault(r["job"], []).append(r)
     assert [(r.get("x"), r.get("y")) for r in by_job["a"]] == [(1, 1), (2, 4)], by_job["a"]
-    assert by_job["die"] == [{"job": "die", "status": "error", "attempts": RAY_ATTEMPTS,
+    assert [core(r) for r in by_job["die"]] == [{"job": "die", "status": "error",
+                                               "attempts": RAY_ATTEMPTS,
                               "reason": f"{WORKER_DIED}: " + by_job["die"][0]["reason"].split(
                                   ": ", 1)[1]}]
     assert summary.n_errors == 1
     assert not ray.is_initialized()  # shut down after the sweep
     assert not any(name.startswith("tg-ray-") for name in set(os.listdir("/tmp")) - before)
+
+
+# --- Progress: counts per outcome, a job's warnings above the bar ---------------------------
+
+def noisy(payload):
+    """A job that writes besides its result: a Python warning, a Drake-style log line, a line
+    from native code on fd 2; its outcome is the payload."""
+    import logging
+    import warnings
+
+    if payload == "boom":
+        raise RuntimeError("solver failed")
+    warnings.warn(f"mesh has {len(payload)} degenerate faces", UserWarning, stacklevel=1)
+    logging.getLogger("drake").warning("contact penetration is large")
+    os.write(2, b"native: vtk says hello\n")
+    return {"outcome": {"status": payload}}
+
+
+def status_of(records):
+    return records[0]["outcome"]["status"]
+
+
+BAR = re.compile(r"r\.jsonl: +\d+%\|.*\| \d+/\d+ \[[\d:]+, ETA [\d:?]+, .*\]")
+
+
+def test_the_bar_counts_outcomes_and_a_workers_warnings_leave_its_lines_intact(tmp_path, capfd):
+    out = tmp_path / "r.jsonl"
+    jobs = [Job(f"j{i}", s) for i, s in enumerate(["placed", "failed", "placed", "boom"])]
+    summary = run_jobs(noisy, jobs, out=out, executor=LocalExecutor(workers=2),
+                       outcome_of=status_of)
+    assert summary.counts == {"placed": 2, "failed": 1, "error": 1}
+    err = capfd.readouterr().err
+    lines = [line for line in re.split(r"[\r\n]", err) if line.strip()]
+    bars = [line for line in lines if line.startswith("r.jsonl:")]
+    assert bars and all(BAR.fullmatch(line.strip()) for line in bars), bars
+    assert "placed=2" in bars[-1] and "failed=1" in bars[-1] and "error=1" in bars[-1]
+    assert "100%" in bars[-1] and "ETA 00:00" in bars[-1]
+    others = [line for line in lines if not line.startswith("r.jsonl:")]
+    # Each distinct line once, on a line of its own above the bar, naming its job.
+    assert sum("native: vtk says hello" in line for line in others) == 1
+    assert sum("contact penetration is large" in line for line in others) == 1
+    assert all(re.match(r"j\d: ", line) for line in others), others
+    by_job = {r["job"]: r for r in read(out)}
+    for key in ("j0", "j1", "j2"):  # and every line in each job's record
+        log = by_job[key]["log"]
+        assert any(line.startswith("UserWarning: mesh has 6 degenerate faces") for line in log)
+        assert "[drake] WARNING: contact penetration is large" in log
+        assert "native: vtk says hello" in log
+    assert "log" not in by_job["j3"]
+
+
+def test_a_job_in_this_process_keeps_its_warnings_in_its_record(tmp_path, capfd):
+    out = tmp_path / "r.jsonl"
+    run_jobs(noisy, [Job("a", "placed")], out=out, executor=LocalExecutor(workers=0),
+             progress=False)
+    (record,) = read(out)
+    assert re.fullmatch(r"UserWarning: mesh has 6 degenerate faces \(test_executor\.py:\d+\)",
+                        record["log"][0])
+    assert record["log"][1] == "[drake] WARNING: contact penetration is large"
+    err = capfd.readouterr().err
+    assert "degenerate" not in err and "penetration" not in err  # not on stderr: in the record
+    assert record["worker_pid"] == os.getpid()
+
+
+def thread_settings(_):
+    from tg_drake.executor import THREAD_VARIABLES
+
+    return {name: os.environ.get(name) for name in THREAD_VARIABLES}
+
+
+def test_pool_workers_get_their_share_of_the_cores_for_thread_pools(tmp_path, monkeypatch):
+    monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "3")  # the user's setting is kept
+    out = tmp_path / "r.jsonl"
+    run_jobs(thread_settings, [Job("a", None)], out=out, executor=LocalExecutor(workers=2),
+             progress=False)
+    (record,) = read(out)
+    assert record["OMP_NUM_THREADS"] == str(max(1, (os.cpu_count() or 1) // 2))
+    assert record["OPENBLAS_NUM_THREADS"] == "3"

@@ -8,6 +8,10 @@ setting; a rerun skips finished cases; a crashed case is recorded as an error an
 failure), then `tables.json`, `tables.md` and PNG plots derived from every record of the suites
 given (`--name logic`: logic.json, logic.md, logic_*.png). `--tables-only` derives the tables
 from the records already there.
+
+`--shard I/N` runs the I-th of N deterministic slices of the cases into `results-I-of-N.jsonl`
+(tg_drake.evaluation.shards); the tables are always derived from every results file in DIR (and
+any given with `--merge`), duplicates and missing cases reported.
 """
 
 from __future__ import annotations
@@ -22,6 +26,14 @@ from pathlib import Path
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
+from tg_drake.evaluation.shards import (
+    merge,
+    object_set,
+    parse_shard,
+    results_files,
+    shard,
+    shard_file,
+)
 from tg_drake.executor import read_records as read_results
 from tg_drake.types import THEORY_VARIANTS as VARIANTS
 
@@ -53,7 +65,14 @@ def add_arguments(parser) -> None:
                         help="file stem of the tables (NAME.json, NAME.md) and, unless 'tables', "
                              "prefix of the plots (NAME_accuracy.png, ...)")
     parser.add_argument("--tables-only", action="store_true",
-                        help="only derive the tables and plots from DIR/results.jsonl")
+                        help="only derive the tables and plots from the results files in DIR "
+                             "(results.jsonl and the shards' results-I-of-N.jsonl)")
+    parser.add_argument("--shard", default=None, metavar="I/N",
+                        help="run only the I-th of N deterministic slices of the cases (1 ≤ I ≤ "
+                             "N), into DIR/results-I-of-N.jsonl; merge with --tables-only")
+    parser.add_argument("--merge", type=Path, action="append", default=[], metavar="PATH",
+                        help="with the tables: also read this results file, or the results "
+                             "files of this folder (repeatable)")
 
 
 def load_cases(paths) -> list:
@@ -83,25 +102,36 @@ def _ordered(cases) -> list:
     if len(set(keys)) != len(keys):
         dup = sorted({k for k in keys if keys.count(k) > 1})
         raise ScenarioError(f"the same case in two suites (a suite given twice?): {dup[0]}")
-    # Executed runs in a fixed shuffled order of their scenarios (a sweep cut short is a sample
-    # of every category and scene), each scenario's variants together.
+    # Executed runs in a fixed shuffled order of their object sets (a sweep cut short is a sample
+    # of every category and scene), each set's scenarios together (a warm worker meets its objects
+    # again), each scenario's variants together.
     order = {"synthetic": 0, "perceived": 1, "executed": 2}
-    return sorted(cases, key=lambda c: (order[c.kind], zlib.crc32(
-        c.key.split("/", 1)[1].split("@")[0].encode()) if c.kind == "executed" else 0))
+
+    def crc(text: str) -> int:
+        return zlib.crc32(text.encode())
+
+    return sorted(cases, key=lambda c: (order[c.kind], *(
+        (crc(repr(object_set(c))), crc(c.key.split("/", 1)[1].split("@")[0]))
+        if c.kind == "executed" else (0, 0))))
 
 
 def read_records(out: Path, cases) -> list[dict]:
-    """The records of `cases` in results.jsonl; a case recorded as an error becomes a record with
-    its metadata and "error" (one per setting for a perceived case)."""
+    """The records of `cases` in results.jsonl (records_of)."""
+    return records_of(read_results(out), cases)  # a malformed file is a clear error
+
+
+def records_of(lines: list[dict], cases) -> list[dict]:
+    """The records of `cases` among results lines; a case recorded as an error becomes a record
+    with its metadata and "error" (one per setting for a perceived case)."""
     from tg_drake.evaluation.suite import DATASET_OF_SETTING  # start-up (pydrake)
 
     by_key = {c.key: c for c in cases}
-    lines: dict[str, list[dict]] = {}
-    for r in read_results(out):  # a torn last line left out, a malformed file a clear error
+    grouped: dict[str, list[dict]] = {}
+    for r in lines:
         if r["job"] in by_key:
-            lines.setdefault(r["job"], []).append(r)
+            grouped.setdefault(r["job"], []).append(r)
     records = []
-    for key, rs in lines.items():
+    for key, rs in grouped.items():
         ok = [r for r in rs if r.get("status") != "error"]
         if ok:  # a case rerun after an error (--retry-errors) keeps its good records
             records += ok
@@ -131,6 +161,12 @@ def main(args) -> int:
     if not re.fullmatch(r"[\w.-]+", args.name):
         raise ScenarioError(f"--name is a file stem (letters, digits, '_', '-', '.'), got "
                             f"{args.name!r}", field="--name")
+    sharded = None
+    if args.shard is not None:
+        if args.tables_only:
+            raise ScenarioError("--tables-only merges every shard's results: leave --shard out",
+                                field="--shard")
+        sharded = parse_shard(args.shard)
     cases = load_cases(args.suites)
     if args.theory != "specific":
 
@@ -139,14 +175,23 @@ def main(args) -> int:
                                field="--theory")
         cases = [dataclasses.replace(c, key=f"{c.key}#{args.theory}", theory=args.theory)
                  for c in cases]
-    out = args.out / "results.jsonl"
+    out = shard_file(args.out, *sharded) if sharded else args.out / "results.jsonl"
     if not args.tables_only:
+        todo = shard(cases, *sharded) if sharded else cases
         executor = make_executor(args.executor, workers=args.workers, address=args.address)
-        summary = run_jobs(_run, [Job(c.key, c) for c in cases], out=out, executor=executor,
-                           retry_errors=args.retry_errors)
-        print(f"{summary.n_jobs} cases: {summary.n_skipped} already done, {summary.n_ran} run now "
-              f"({summary.n_errors} recorded as errors)", file=sys.stderr)
-    records = read_records(out, cases)
+        summary = run_jobs(_run, [Job(c.key, c) for c in todo], out=out, executor=executor,
+                           retry_errors=args.retry_errors, outcome_of=outcome_label)
+        where = f"shard {sharded[0]}/{sharded[1]}: " if sharded else ""
+        print(f"{where}{summary.n_jobs} cases: {summary.n_skipped} already done, {summary.n_ran} "
+              f"run now ({summary.n_errors} recorded as errors)", file=sys.stderr)
+        if sharded:
+            print(f"{where}results in {out}; when every shard is done and its results file is in "
+                  f"{args.out}, write the tables with --tables-only", file=sys.stderr)
+            return 0
+    merged = merge(results_files(args.out, args.merge), cases)
+    if merged.duplicates or merged.missing or len(merged.files) > 1 or merged.foreign:
+        print(merged.report(), file=sys.stderr)
+    records = records_of(merged.records, cases)
     # The command that regenerates the tables: the sweep itself (it resumes, then derives them).
     argv = [a for a in sys.argv[2:] if a != "--tables-only"]
     command = "tg-drake eval " + " ".join(shlex.quote(a) for a in argv) \
@@ -161,11 +206,22 @@ def main(args) -> int:
         n[1] += 1
     coverage = (f"Cases with records: {len(done)} of {len(cases)} ("
                 + ", ".join(f"{s} {a}/{b}" for s, (a, b) in per_suite.items()) + ").")
+    if len(merged.files) > 1 or merged.duplicates:
+        coverage += " " + " ".join(line.rstrip(".") + "." for line in
+                                   merged.report().splitlines())
     tables = write_tables(folder, records, command,
                           notes=suite_notes(args.suites) + "\n\n" + coverage, name=args.name)
     print(f"{len(done)} of {len(cases)} cases have records; tables in {folder}/{args.name}.md "
           f"({tables['n_errors']} crashed cases counted as failures)")
     return 0
+
+
+def outcome_label(records: list[dict]) -> str:
+    """A finished case's word in the progress bar: an executed run's outcome status (placed,
+    lifted, grasped, failed), else "done"."""
+    statuses = [r["outcome"].get("status") for r in records
+                if isinstance(r.get("outcome"), dict)]
+    return statuses[0] if statuses and statuses[0] else "done"
 
 
 def _run(case):

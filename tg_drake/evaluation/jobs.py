@@ -11,7 +11,8 @@ table can be derived again from the records (tg_drake.evaluation.tables).
   task (inferred) and, for each ground-truth task given, the pre-grasp part.
 - perceived: the object's depth image ray cast from the default camera's viewpoint and perceived;
   pose and part detection against the truth; then the same queries on observations of each setting.
-- executed: `tg_drake.run.run_scenario` on the scenario in the case's variant.
+- executed: `tg_drake.run.run_scenario` on the scenario in the case's variant; `build_s` is the
+  wall time of building its diagram and context [s] (the executor adds `worker_pid` and `rss_mb`).
 """
 
 from __future__ import annotations
@@ -192,7 +193,8 @@ def run_perceived(case) -> list[dict]:
     return records
 
 
-def run_executed(case) -> dict:
+def scenario_of(case) -> Scenario:
+    """The scenario an executed case runs (validated)."""
     pipeline = PipelineConfig(scoring=LocalOnly() if case.variant == "local" else DgiScorer())
     pipeline.logic.category = pipeline.logic.grasp = case.theory
     pipeline.logic.use_prior = case.variant != "pipeline_uniform"
@@ -201,10 +203,15 @@ def run_executed(case) -> dict:
                                         place_xy=list(case.place_xy)),
                         object_libraries=list(case.object_libraries))
     validate(scenario, where=case.key)
-    result = run_scenario(scenario, scenario_path=case.key)
+    return scenario
+
+
+def run_executed(case) -> dict:
+    result = run_scenario(scenario_of(case), scenario_path=case.key)
     keep = ("perception", "category_prior", "category", "task", "part", "grasp",
             "grasp_probability", "n_hypotheses", "planning", "outcome", "timings")
-    return {**case.meta(), **{k: result[k] for k in keep if k in result}}
+    return {**case.meta(), **{k: result[k] for k in keep if k in result},
+            "build_s": round(result["timings"]["build"], 3)}
 
 
 def run_case(case) -> dict | list[dict]:

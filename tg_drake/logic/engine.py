@@ -44,6 +44,7 @@ from problog.program import SimpleProgram
 from pysdd.sdd import SddManager, Vtree
 
 from tg_drake.errors import RuleError
+from tg_drake.logic.cache import cached
 from tg_drake.logic.circuit import Circuit
 from tg_drake.logic.names import TASK_ATOMS
 from tg_drake.logic.observations import (
@@ -383,13 +384,15 @@ def _key(config: TheoryConfig, directory: Path | None):
 @functools.lru_cache(maxsize=8)
 def _compiled(key) -> CompiledTheory:
     config, directory, _ = key
-    return CompiledTheory(config, Path(directory))
+    # Compiled once per machine (tg_drake.logic.cache), then loaded by every process.
+    return cached(config, theory_paths(config, Path(directory)),
+                  lambda: CompiledTheory(config, Path(directory)))
 
 
 def compiled_theory(config: TheoryConfig = DEFAULT_THEORY,
                     directory: Path | None = None) -> CompiledTheory:
-    """The compiled theory for a variant, compiled once per process (and again if a theory file
-    changes)."""
+    """The compiled theory for a variant, compiled once per machine and loaded once per process
+    (and again if a theory file changes)."""
     return _compiled(_key(config, directory))
 
 
