@@ -1,9 +1,9 @@
 """The object-wise split: which objects a model or a threshold may be fit on, which are held out.
 
 Every fitted figure (the hold model, a perception likelihood, the kernel database, a learned
-theory) is fit on `train` objects only and reported on `held_out` ones (../shared/DESIGN.md,
-"Evaluation discipline"). The split is one file, `scenarios/suites/split.yaml`, with one entry per
-object set:
+theory) is fit on `train` objects only and reported on `held_out` ones; nothing is tuned on
+the suites we report (docs/results/generalization.md, the protocol). The split is one file,
+`scenarios/suites/split.yaml`, with one entry per object set:
 
     sets:
       a:                          # the shipped library (tools/make_objects.py)
