@@ -121,33 +121,35 @@ NOT_MEASURED = "not measured yet"
 PROTOCOL = """\
 ## Protocol
 
-- **Object sets.** Set a: the shipped library (`models/objects/`, 44 objects, `tools/make_objects.py`).
-  Set b: a second generated set (`models/objects_b/`, 44 objects, `tools/make_objects.py --set b`)
-  with another seed and wider shape families: lidded pots with two side handles, pots with two side
-  handles from squat to tall, stemmed glasses, squat (3 cm) and tall cans, square and shouldered
-  bottles, mugs with a tall D handle or a small ring handle, flat one-piece knives 2–5 mm thick,
-  heavy (club) hammers of 1.7–1.9 kg, wider ladles and spatulas (the family of each object is its
-  `family` field in `models/objects_b/library.yaml`).
-- **Split** (`scenarios/suites/split.yaml`, `tg_drake.evaluation.split.load_split`), object-wise and
-  per category, fixed before anything was measured on it: set a trains on its `*_01`–`*_03`
+- **Object sets.** Set a: the shipped library (`models/objects/`, 44 objects,
+  `tools/make_objects.py`). Set b: a second generated set (`models/objects_b/`, 44 objects,
+  `tools/make_objects.py --set b`) with another seed and wider shape families: lidded pots with
+  two side handles, pots with two side handles from squat to tall, stemmed glasses, squat (3 cm)
+  and tall cans, square and shouldered bottles, mugs with a tall D handle or a small ring handle,
+  flat one-piece knives 2–5 mm thick, heavy (club) hammers of 1.7–1.9 kg, wider ladles and
+  spatulas (the family of each object is its `family` field in `models/objects_b/library.yaml`).
+- **Split** (`scenarios/suites/split.yaml`, `tg_drake.evaluation.split.load_split`), object-wise
+  and per category, fixed before anything was measured on it: set a trains on its `*_01`–`*_03`
   objects and holds out `*_04`; set b trains on `*_b01`, `*_b02` and holds out `*_b03`, `*_b04`
   (one instance of each shape family on each side). Training: 55 objects; held out: 33.
-- **Scan-like.** `python tools/make_scanlike.py --all --import [--library models/objects_b]`
-  makes every object of a set scan-like (about 50k triangles, surface noise, holes, cut into
-  pieces, mm, y up, flipped and zero-area faces) and imports it (repair, frame, convex collision
-  pieces, resting poses) into a library in the cache, as `<id>_scan`, on its original's side of
-  the split. Scan-like objects are never committed.
+- **Scan-like.** `python tools/make_scanlike.py --all --import [--library models/objects_b]` makes
+  every object of a set scan-like (about 50k triangles, surface noise, holes, cut into pieces, mm,
+  y up, flipped and zero-area faces) and imports it (repair, frame, convex collision pieces,
+  resting poses) into a library in the cache, as `<id>_scan`, on its original's side of the split.
+  Scan-like objects are never committed.
 - **What is fit on what.** Every threshold, likelihood and learned model (the hold model of the
   feasibility stage, the perception likelihoods, the kernel database, a learned theory) is fit on
   training objects only (their generated and scan-like versions) and reported here on both sides;
-  nothing is tuned on the suites below. Today's shipped kernel database holds every set-a object
-  and is queried leave-one-object-out: its set-a held-out figures are not held out yet (set b's
-  objects are in no database).
-- **Measures**: those of `docs/results/tables.md` (`tg_drake.evaluation.tables`): category from the
-  argmax, ties failing; pose and parts as detected; pre-grasp E0 on set-valued ground truth;
+  nothing is tuned on the suites below. Models shipped before this protocol were built on all of
+  set a: the kernel database holds every set-a object (queried leave-one-object-out) and the DGI
+  was trained on grasps of all 44 (docs/results/dgi.json `n_objects`), so set a's held-out
+  figures are not held out yet for them; set b's objects are in neither.
+- **Measures**: those of `docs/results/tables.md` (`tg_drake.evaluation.tables`): category from
+  the argmax, ties failing; pose and parts as detected; pre-grasp E0 on set-valued ground truth;
   executed runs: grasped and placed of the runs with a reachable pre-grasp, executed E0 (the
-  executed grasp's part acceptable and the object held through the lift). `held_out −
-  train` is in points.
+  executed grasp's part acceptable and the object held through the lift). `held_out − train` is in
+  points.
+
 """
 
 
