@@ -93,7 +93,7 @@ def compute(records: list[dict], split: Split) -> dict:
     out: dict = {"groups": {}, "by_set": {}, "per_category": {},
                  "unassigned_objects": sorted(unassigned),
                  "n_records": sum(len(v) for v in grouped.values()),
-                 "sets": {name: {"library": str(s.library), "n_train": len(s.train),
+                 "sets": {name: {"library": f"models/{s.library.name}", "n_train": len(s.train),
                                  "n_held_out": len(s.held_out)}
                           for name, s in split.sets.items()}}
     for side, source in GROUPS:
