@@ -990,7 +990,7 @@ def make_lidded_pot(P, variant):
                                 1), 0, 1, z_keys=keys)
     pr.line((0.6 * rk, z_knob), (0.6 * rk, z_knob + 0.4 * hk))
     pr.line((0.6 * rk, z_knob + 0.4 * hk), (rk, z_knob + 0.55 * hk))
-    pr.line((rk, z_knob + 0.55 * hk), (rk, T - 0.002))
+    pr.line((rk, z_knob + 0.55 * hk), (rk, T - 0.002))  # the knob's top edge: a 2 mm chamfer
     pr.line((rk, T - 0.002), (rk - 0.002, T))
     pr.line((rk - 0.002, T), (0.0, T), h=1.0)
     prof = pr.resampled(h)
@@ -1034,6 +1034,8 @@ def make_stemmed_glass(P, variant):
     if not (bowl[0, 1] == 0.0 and bowl[1, 1] == 0.0 and bowl[2, 1] > 0.0):
         raise RuntimeError("the bowl profile does not start with its flat bottom")
     r1 = float(bowl[1, 0])  # where the stem meets the bowl
+    # [m] the foot's edge: a 1.5 mm chamfer; it rises 8 mm to the stem, which flares over its
+    # last 8 mm into the bowl
     pr = Profile()
     pr.line((0.0, 0.0), (R_f - 0.0015, 0.0), h=1.0)
     pr.line((R_f - 0.0015, 0.0), (R_f, 0.0015))
