@@ -1,9 +1,17 @@
 """Generates the object library in models/objects/ from parametric shape families.
 
-    python tools/make_objects.py            # (re)write models/objects/
+    python tools/make_objects.py            # (re)write models/objects/ (set a, shipped)
     python tools/make_objects.py --check    # regenerate into a temp dir, compare bytes,
                                             # exit 1 on a difference
     python tools/make_objects.py --out DIR  # write elsewhere
+    python tools/make_objects.py --set b    # set b: models/objects_b/ (with --check, --out)
+
+Two object sets, one format. Set a is the shipped library (SEED, RANGES, VARIANTS). Set b (issue
+20's held-out protocol, scenarios/suites/split.yaml) has another seed and wider shape families —
+lidded pots, pots with two side handles, stemmed glasses, squat and tall cans, square and
+shouldered bottles, mugs with varied handles, flat knives 2–5 mm thick, heavy hammers, ladles —
+whose parameters are the one table FAMILIES_B; it is a user library (ids <category>_bNN, its
+folder named in a scenario's `object_libraries:`), its library.yaml entries adding `family`.
 
 Every object of the 11 categories is built from a few closed-surface primitives, with NumPy only
 (scipy for convex hulls):
@@ -388,18 +396,23 @@ class Profile:
                         np.concatenate(self.h))
 
 
-def revolve(profile: np.ndarray, n: int, *, p=2.0, R=None, origin=None):
+def revolve(profile: np.ndarray, n: int, *, p=2.0, R=None, origin=None, p_of_z=None):
     """Rings of a profile (r, z) from the axis to the axis, revolved about local z.
 
     Ring vertices sit at angles (j + ½)·2π/n, so faces are centred on multiples of 2π/n (a face
     points exactly along ±x and ±y when n is a multiple of 4). Returns (rings, start pole, end pole)
-    in the frame (R, origin), by default the identity.
+    in the frame (R, origin), by default the identity. p_of_z(z) (optional) gives each ring's
+    section exponent from its height (a square body under a round neck).
     """
     R = np.eye(3) if R is None else R
     origin = np.zeros(3) if origin is None else origin
-    sec = superellipse(n, 1.0, 1.0, p, phase=np.pi / n)
     inner = profile[1:-1]
-    loc = np.concatenate([inner[:, :1, None] * sec[None, :, :],
+    if p_of_z is None:
+        sec = superellipse(n, 1.0, 1.0, p, phase=np.pi / n)[None, :, :]
+    else:
+        sec = np.stack([superellipse(n, 1.0, 1.0, float(pz), phase=np.pi / n)
+                        for pz in p_of_z(inner[:, 1])])
+    loc = np.concatenate([inner[:, :1, None] * sec,
                           np.broadcast_to(inner[:, None, 1:], (len(inner), n, 1))], 2)
     to_world = lambda q: q @ R.T + origin  # noqa: E731
     return (to_world(loc), to_world(np.array([0.0, 0.0, profile[0, 1]])),
@@ -674,6 +687,8 @@ class Model:
     cavity: tuple | None  # containers: (volume [m³], height of its centroid [m]) filled to the rim
     dimensions: dict
     rim: dict = field(default_factory=dict)
+    closed_top: bool = False  # an open-container category closed by a lid (no rim to pinch)
+    poses: tuple | None = None  # the poses that suit it, when not its category's (POSES_OF)
 
 
 def lhs(rng, n, ranges: dict) -> list[dict]:
@@ -763,8 +778,8 @@ def offset_closed_profile(prof, t):
     return q
 
 
-def body_of_revolution(mb, prof, n, *, label_fn, R=None, origin=None, p=2.0):
-    rings, s, e = revolve(prof, n, p=p, R=R, origin=origin)
+def body_of_revolution(mb, prof, n, *, label_fn, R=None, origin=None, p=2.0, p_of_z=None):
+    rings, s, e = revolve(prof, n, p=p, R=R, origin=origin, p_of_z=p_of_z)
     labels = label_fn(prof)
     idx, qf = loft(mb, rings, labels[1:-1], start=s, end=e, start_label=labels[0],
                    end_label=labels[-1])
@@ -795,6 +810,30 @@ def wall_point(r_of_z, phi, z, dz=1e-4):
     return np.array([r * c, r * s, z]), n / np.linalg.norm(n)
 
 
+def side_handles(mb, qf, r_of_z, r_top, zh, hp, P):
+    """Two loop handles at ±x on a revolved wall (a pot's), centred at height zh, each spanning
+    P["span"] along the wall, of round section radius P["hr"], reaching P["reach"] out. Returns
+    their closed solids (for a handle of its own material)."""
+    e_z = np.array([0.0, 0.0, 1.0])
+    half_span = P["span"] / 2
+    pieces = []
+    for phi0 in (0.0, np.pi):
+        ends = []
+        for sgn in (-1, 1):
+            phi = phi0 + sgn * half_span / r_top
+            ends.append((phi, *wall_point(r_of_z, phi, zh)))
+        loops = [patch_on_wall(mb, qf, phi, P["hr"] + 0.004, zh - hp, zh + hp)
+                 for phi, _, _ in ends]
+        (_, p1, n1), (_, p2, n2) = ends
+        k = P["reach"] * 1.3
+        curve = lambda t, p1=p1, n1=n1, p2=p2, n2=n2, k=k: bezier(  # noqa: E731
+            p1, p1 + k * n1, p2 + k * n2, p2, t)
+        tidx, rings, _ = tube(mb, curve, e_z, P["hr"], P["hr"], HANDLE,
+                              start_loop=loops[0], end_loop=loops[1], h=0.008, n_sec=12)
+        pieces.append(closed_tube_solid(rings))
+    return pieces
+
+
 def make_open_container(category, P, variant):
     """pan, pot, cup, glass, bowl: a revolved profile with a cavity, plus handles."""
     H, r_top, wall, base = P["H"], P["r_top"], P["wall"], P["base"]
@@ -819,7 +858,7 @@ def make_open_container(category, P, variant):
                                              P["chamfer"], h, z_keys)
     lab = lambda pr: thirds_labels(pr[:, 1], top)  # noqa: E731
     idx, qf = body_of_revolution(mb, prof, n, label_fn=lab)
-    e_y, e_z = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    e_y = np.array([0.0, 1.0, 0.0])
     pieces = []
     dims = {"height": top, "diameter": 2 * r_top, "bottom_diameter": 2 * r_bot, "wall": wall,
             "base": base}
@@ -832,7 +871,7 @@ def make_open_container(category, P, variant):
         k = reach * 1.2
         curve = lambda t: bezier(p1, p1 + k * n1, p2 + k * n2, p2, t)  # noqa: E731
         tidx, rings, _ = tube(mb, curve, e_y, P["ha"], P["hb"], HANDLE, start_loop=A,
-                              end_loop=B, h=0.007)
+                              end_loop=B, h=0.007, p=P.get("handle_p", 2.0))
         pieces.append(closed_tube_solid(rings))
         dims["handle_reach"] = float(mb.V[tidx][:, 0].max() - r_of_z(z1))
     elif category == "pan":
@@ -847,21 +886,7 @@ def make_open_container(category, P, variant):
         pieces.append(closed_tube_solid(rings, end_pole=pole))
         dims["handle_length"] = P["L"]
     elif category == "pot":
-        half_span = P["span"] / 2
-        for phi0 in (0.0, np.pi):
-            ends = []
-            for sgn in (-1, 1):
-                phi = phi0 + sgn * half_span / r_top
-                ends.append((phi, *wall_point(r_of_z, phi, zh)))
-            loops = [patch_on_wall(mb, qf, phi, P["hr"] + 0.004, zh - hp, zh + hp)
-                     for phi, _, _ in ends]
-            (_, p1, n1), (_, p2, n2) = ends
-            k = P["reach"] * 1.3
-            curve = lambda t, p1=p1, n1=n1, p2=p2, n2=n2, k=k: bezier(  # noqa: E731
-                p1, p1 + k * n1, p2 + k * n2, p2, t)
-            tidx, rings, _ = tube(mb, curve, e_z, P["hr"], P["hr"], HANDLE,
-                                  start_loop=loops[0], end_loop=loops[1], h=0.008, n_sec=12)
-            pieces.append(closed_tube_solid(rings))
+        pieces += side_handles(mb, qf, r_of_z, r_top, zh, hp, P)
         dims["handle_reach"] = P["reach"]
     V, F, L = mb.result()
     mats = variant["materials"]
@@ -915,17 +940,121 @@ def make_closed_container(category, P, variant):
         pr.line((R - 0.0075, H - 0.004), (0.0, H - 0.004))
         dims = {"height": H, "diameter": 2 * R, "wall": P["wall"]}
     prof = pr.resampled(h)
+    p_of_z = None
+    if "p_body" in P:  # a square body (superellipse sections) blending into a round neck
+        z0, z1 = H - P["neck"] - P["shoulder"], H - P["neck"]
+        w = lambda z: 0.5 * (1 + np.cos(np.pi * np.clip((z - z0) / (z1 - z0), 0, 1)))  # noqa: E731
+        p_of_z = lambda z: 2.0 + (P["p_body"] - 2.0) * w(np.asarray(z))  # noqa: E731
+        dims["section_exponent"] = P["p_body"]
     mb = MeshBuilder()
-    body_of_revolution(mb, prof, n, label_fn=lambda q: thirds_labels(q[:, 1], H))
+    body_of_revolution(mb, prof, n, label_fn=lambda q: thirds_labels(q[:, 1], H), p_of_z=p_of_z)
     V, F, L = mb.result()
     cav = offset_closed_profile(prof, P["wall"])
     cmb = MeshBuilder()
-    rings, s, e = revolve(cav, n)
+    rings, s, e = revolve(cav, n, p_of_z=p_of_z)
     loft(cmb, rings, 0, start=s, end=e)
     Vc, Fc, _ = cmb.result()
     vol, first, _ = volume_integrals(Vc, Fc)
     cavity = (vol, first[2] / vol)
     return Model(category, V, F, L, variant["material"], {}, [(Vc, Fc, "air")], cavity, dims)
+
+
+def make_lidded_pot(P, variant):
+    """A pot closed by a domed lid with a knob, resting on its rim, and two side handles: one
+    closed surface (the lid's overhang and the wall's top are one solid); the cavity under the
+    lid is a sub-solid of air, and the cavity of a 'full' pot (as a closed bottle's or can's)."""
+    H, r_top, wall, base = P["H"], P["r_top"], P["wall"], P["base"]
+    r_bot = r_top - P["taper"]
+    n, h, c = 48, 0.015, 0.003  # sections, profile spacing [m], bottom chamfer [m]
+    ov, e, t = P["overhang"], P["lid_edge"], P["lid_t"]  # lid overhang, edge height, sheet [m]
+    R_l, rk, hk = r_top + ov, P["knob_r"], P["knob_h"]
+    zh, hp = H - P["hr"] - 0.012, P["hr"] + 0.003  # handle height and patch half height [m]
+
+    def r_of_z(z):
+        return r_bot + (r_top - r_bot) * np.asarray(z) / H
+
+    def dome(r):  # the lid's top surface [m]: a paraboloid from its edge to the knob
+        return H + e + P["dome"] * (1 - (np.asarray(r) / R_l) ** 2)
+
+    z_knob = float(dome(0.6 * rk))
+    T = z_knob + hk  # the top of the knob: the object's height
+    keys = [T / 3, 2 * T / 3]
+    pr = Profile()
+    pr.line((0.0, 0.0), (r_bot - c, 0.0), h=1.0)
+    pr.line((r_bot - c, 0.0), (float(r_of_z(c)), c))
+    pr.curve(lambda u: np.stack([r_of_z(c + u * (H - c)), c + u * (H - c)], 1), 0, 1,
+             z_keys=[zh - hp, zh + hp, *keys])
+    pr.line((r_top, H), (R_l, H))
+    pr.line((R_l, H), (R_l, H + e))
+    pr.curve(lambda u: np.stack([R_l + (0.6 * rk - R_l) * u, dome(R_l + (0.6 * rk - R_l) * u)],
+                                1), 0, 1, z_keys=keys)
+    pr.line((0.6 * rk, z_knob), (0.6 * rk, z_knob + 0.4 * hk))
+    pr.line((0.6 * rk, z_knob + 0.4 * hk), (rk, z_knob + 0.55 * hk))
+    pr.line((rk, z_knob + 0.55 * hk), (rk, T - 0.002))  # the knob's top edge: a 2 mm chamfer
+    pr.line((rk, T - 0.002), (rk - 0.002, T))
+    pr.line((rk - 0.002, T), (0.0, T), h=1.0)
+    prof = pr.resampled(h)
+    mb = MeshBuilder()
+    idx, qf = body_of_revolution(mb, prof, n, label_fn=lambda q: thirds_labels(q[:, 1], T))
+    pieces = side_handles(mb, qf, r_of_z, r_top, zh, hp, P)
+    V, F, L = mb.result()
+
+    # the air under the lid: the inner wall (the outer one less `wall`) from the inner bottom up
+    # to the lid, whose underside is its top surface less the sheet `t`
+    r_c = r_top - wall
+    q = Profile()
+    q.line((0.0, base), (float(r_of_z(base)) - wall, base), h=1.0)
+    q.line((float(r_of_z(base)) - wall, base), (r_c, H), h=1.0)
+    q.line((r_c, H), (r_c, float(dome(r_c)) - t), h=1.0)
+    q.curve(lambda u: np.stack([r_c * (1 - u), dome(r_c * (1 - u)) - t], 1), 0, 1, n=40)
+    cmb = MeshBuilder()
+    rings, s_, e_ = revolve(q.resampled(h), n)
+    loft(cmb, rings, 0, start=s_, end=e_)
+    Vc, Fc, _ = cmb.result()
+    vol, first, _ = volume_integrals(Vc, Fc)
+    hm = variant["materials"].get("handle", variant["material"])
+    solids = [(Vc, Fc, "air")] + ([(Vp, Fp, hm) for Vp, Fp in pieces]
+                                  if hm != variant["material"] else [])
+    dims = {"height": T, "diameter": 2 * r_top, "bottom_diameter": 2 * r_bot, "wall": wall,
+            "base": base, "lid_diameter": 2 * R_l, "lid_height": T - H,
+            "handle_reach": P["reach"]}
+    return Model("pot", V, F, L, variant["material"],
+                 {"handle": hm} if hm != variant["material"] else {}, solids,
+                 (vol, first[2] / vol), dims, rim={"wall": wall, "opening_radius": r_c},
+                 closed_top=True, poses=("upright", "sideways"))
+
+
+def make_stemmed_glass(P, variant):
+    """A stemmed (wine) glass: a foot, a stem and an open bowl, one revolved profile."""
+    r_top, wall, Hb = P["r_top"], P["wall"], P["H_bowl"]
+    R_f, t_f, r_s, z_s = P["r_foot"], P["foot_t"], P["r_stem"], P["H_stem"]
+    n, h = 40, 0.011
+    bowl, cavity, _, top_b = open_profile(Hb, P["r_bot"], r_top, wall, P["base"], P["beta"],
+                                          0.002, h)
+    if not (bowl[0, 1] == 0.0 and bowl[1, 1] == 0.0 and bowl[2, 1] > 0.0):
+        raise RuntimeError("the bowl profile does not start with its flat bottom")
+    r1 = float(bowl[1, 0])  # where the stem meets the bowl
+    # [m] the foot's edge: a 1.5 mm chamfer; it rises 8 mm to the stem, which flares over its
+    # last 8 mm into the bowl
+    pr = Profile()
+    pr.line((0.0, 0.0), (R_f - 0.0015, 0.0), h=1.0)
+    pr.line((R_f - 0.0015, 0.0), (R_f, 0.0015))
+    pr.line((R_f, 0.0015), (R_f - 0.0015, t_f))
+    # the foot rises to the stem: flat near its edge, steep at the stem
+    pr.curve(lambda u: np.stack([R_f - 0.0015 + (r_s - R_f + 0.0015) * u, t_f + 0.008 * u ** 4],
+                                1), 0, 1)
+    pr.line((r_s, t_f + 0.008), (r_s, z_s - 0.008))
+    pr.curve(lambda u: np.stack([r_s + (r1 - r_s) * u ** 2, z_s - 0.008 + 0.008 * u], 1), 0, 1)
+    foot = pr.resampled(h)
+    prof = np.concatenate([foot, bowl[2:] + [0.0, z_s]])
+    T = z_s + top_b
+    mb = MeshBuilder()
+    body_of_revolution(mb, prof, n, label_fn=lambda q: thirds_labels(q[:, 1], T))
+    V, F, L = mb.result()
+    dims = {"height": T, "diameter": 2 * r_top, "foot_diameter": 2 * R_f,
+            "stem_diameter": 2 * r_s, "stem_height": z_s, "wall": wall, "base": z_s + P["base"]}
+    return Model("glass", V, F, L, variant["material"], {}, [], (cavity[0], cavity[1] + z_s),
+                 dims, rim={"wall": wall, "opening_radius": r_top - wall})
 
 
 def loft_tool(stations, n_sec, labels):
@@ -990,8 +1119,10 @@ def make_knife(P, variant):
     handle = _split_solid(rings, st, lab.index(USABLE) - 2)
     dims = {"length": x_tip, "handle_length": Lh, "blade_length": Lb, "blade_height": hblade,
             "blade_thickness": tb}
-    return Model("knife", V, F, L, variant["material"], {"handle": variant["materials"]["handle"]},
-                 [(*handle, variant["materials"]["handle"])], None, dims)
+    hm = variant["materials"]["handle"]
+    one_piece = hm == variant["material"]  # a flat knife cut from one sheet
+    return Model("knife", V, F, L, variant["material"], {} if one_piece else {"handle": hm},
+                 [] if one_piece else [(*handle, hm)], None, dims)
 
 
 def _split_solid(rings, st, k_split):
@@ -1224,7 +1355,127 @@ VARIANTS = {
 }
 
 
+# ------------------------------------------------------------------------------------------------
+# Set b (issue 20): another seed and wider shape families, a user library in models/objects_b/
+# (ids <category>_b01 ...). Per category, its families in turn — instance b01 is of the first
+# family, b02 of the second, b03 of the first again, ... — each family's instances drawn by Latin
+# hypercube within its own ranges [m, rad, or the section exponent], its variants (material,
+# style) taken in turn. `shape` picks a builder of its own (else the category's, as in set a);
+# parameters a builder needs that the family does not vary are fixed in `fixed`.
+
+SEED_B = 20260420
+N_PER_CATEGORY_B = 4
+FAMILIES_B = {
+    "pan": [dict(family="frying pan, wider", ranges=dict(
+        r_top=(0.09, 0.14), H=(0.035, 0.070), flare=(0.2, 0.8), wall=(0.0025, 0.0045),
+        base=(0.004, 0.007), beta=(0.2, 0.7), L=(0.13, 0.22), angle=(0.10, 0.30),
+        ha=(0.009, 0.012), hb=(0.006, 0.009)),
+        variants=[dict(material="aluminium", materials={"handle": "plastic"}),
+                  dict(material="steel", materials={}),
+                  dict(material="aluminium", materials={"handle": "wood"}),
+                  dict(material="cast_iron", materials={})])],
+    "pot": [dict(family="lidded pot with two side handles", shape="lidded_pot", ranges=dict(
+        r_top=(0.075, 0.115), H=(0.08, 0.15), taper=(0.0, 0.008), wall=(0.0010, 0.0016),
+        base=(0.003, 0.005), reach=(0.020, 0.030), span=(0.045, 0.065), hr=(0.004, 0.006),
+        overhang=(0.002, 0.004), lid_edge=(0.003, 0.005), lid_t=(0.0010, 0.0015),
+        dome=(0.008, 0.020), knob_r=(0.010, 0.016), knob_h=(0.012, 0.020)),
+        variants=[dict(material="steel", materials={}),
+                  dict(material="aluminium", materials={})]),
+            dict(family="pot with two side handles, squat to tall", ranges=dict(
+                r_top=(0.07, 0.13), H=(0.07, 0.19), taper=(0.0, 0.010),
+                wall=(0.0010, 0.0018), base=(0.003, 0.005), reach=(0.018, 0.035),
+                span=(0.04, 0.08), hr=(0.004, 0.0065)),
+        variants=[dict(material="aluminium", materials={}),
+                  dict(material="steel", materials={})])],
+    "cup": [dict(family="mug, tall D handle of flattened section", ranges=dict(
+        r_top=(0.033, 0.048), H=(0.075, 0.12), taper=(-0.006, 0.012), wall=(0.0035, 0.006),
+        base=(0.006, 0.009), beta=(0.0, 0.35), reach=(0.028, 0.040), z1=(0.80, 0.86),
+        z2=(0.14, 0.22), ha=(0.0065, 0.009), hb=(0.0030, 0.0040), handle_p=(3.0, 4.0)),
+        variants=[dict(material="ceramic", materials={}),
+                  dict(material="plastic", materials={})]),
+            dict(family="mug, small ring handle near the rim", ranges=dict(
+                r_top=(0.035, 0.046), H=(0.07, 0.10), taper=(0.0, 0.008),
+                wall=(0.004, 0.0055), base=(0.006, 0.008), beta=(0.0, 0.25),
+                reach=(0.026, 0.032), z1=(0.78, 0.84), z2=(0.46, 0.54), ha=(0.005, 0.0065),
+                hb=(0.0035, 0.0045), handle_p=(2.0, 2.0)),
+        variants=[dict(material="ceramic", materials={})] * 2)],
+    "glass": [dict(family="stemmed glass", shape="stemmed_glass", ranges=dict(
+        r_top=(0.030, 0.045), H_bowl=(0.07, 0.11), r_bot=(0.010, 0.016), wall=(0.0015, 0.0025),
+        base=(0.004, 0.008), beta=(0.5, 0.9), r_foot=(0.030, 0.040), foot_t=(0.003, 0.005),
+        r_stem=(0.0035, 0.005), H_stem=(0.05, 0.09)),
+        variants=[dict(material="glass", materials={})] * 2),
+              dict(family="tumbler, squat to tall", ranges=dict(
+                  r_top=(0.028, 0.046), H=(0.07, 0.16), taper=(0.0, 0.015),
+                  wall=(0.002, 0.0035), base=(0.006, 0.014)),
+        variants=[dict(material="glass", materials={}), dict(material="plastic", materials={})])],
+    "bowl": [dict(family="bowl, wider", ranges=dict(
+        r_top=(0.055, 0.090), H=(0.040, 0.085), r_bot=(0.025, 0.045), wall=(0.0035, 0.006),
+        base=(0.005, 0.008), beta=(0.3, 0.95)),
+        variants=[dict(material="ceramic", materials={}), dict(material="glass", materials={}),
+                  dict(material="plastic", materials={}),
+                  dict(material="ceramic", materials={})])],
+    "bottle": [dict(family="square bottle", ranges=dict(
+        R=(0.028, 0.040), H=(0.18, 0.28), rn=(0.0125, 0.016), neck=(0.04, 0.07),
+        shoulder=(0.03, 0.05), punt=(0.002, 0.006), lip=(0.0015, 0.003), p_body=(4.0, 6.0)),
+        variants=[dict(material="glass", materials={}, wall=0.003),
+                  dict(material="pet", materials={}, wall=0.0005)]),
+               dict(family="shouldered bottle", ranges=dict(
+                   R=(0.032, 0.042), H=(0.24, 0.32), rn=(0.0125, 0.015), neck=(0.07, 0.10),
+                   shoulder=(0.010, 0.018), punt=(0.004, 0.014), lip=(0.0015, 0.003)),
+        variants=[dict(material="glass", materials={}, wall=0.0035),
+                  dict(material="glass", materials={}, wall=0.003)])],
+    "can": [dict(family="squat can", ranges=dict(R=(0.040, 0.050), H=(0.030, 0.045)),
+                 variants=[dict(material="steel", materials={}, wall=0.00022),
+                           dict(material="aluminium", materials={}, wall=0.0002)]),
+            dict(family="tall can", ranges=dict(R=(0.026, 0.033), H=(0.15, 0.19)),
+                 variants=[dict(material="aluminium", materials={}, wall=0.00015),
+                           dict(material="steel", materials={}, wall=0.00022)])],
+    "hammer": [dict(family="heavy hammer", ranges=dict(
+        Lh=(0.22, 0.30), Lhead=(0.11, 0.15), rhead=(0.019, 0.024), ha=(0.015, 0.018),
+        hb=(0.010, 0.012), p=(2.5, 4.0), peen=(0.8, 0.95)),
+        variants=[dict(material="steel", materials={"handle": "wood"}),
+                  dict(material="steel", materials={"handle": "plastic"})]),
+               dict(family="hammer, wider", ranges=dict(
+                   Lh=(0.20, 0.34), Lhead=(0.08, 0.13), rhead=(0.011, 0.017),
+                   ha=(0.012, 0.017), hb=(0.008, 0.011), p=(3.0, 4.5), peen=(0.55, 0.85)),
+        variants=[dict(material="steel", materials={"handle": "wood"}),
+                  dict(material="steel", materials={"handle": "plastic"})])],
+    "knife": [dict(family="flat knife, 2-5 mm thick", ranges=dict(
+        Lh=(0.08, 0.12), Lb=(0.08, 0.18), ha=(0.008, 0.011), hb=(0.0010, 0.0025),
+        blade_h=(0.016, 0.035), blade_t=(0.0012, 0.0018)),
+        variants=[dict(material="steel", materials={"handle": "steel"}),
+                  dict(material="steel", materials={"handle": "plastic_tang"})]),
+              dict(family="knife, wider", ranges=dict(
+                  Lh=(0.08, 0.13), Lb=(0.07, 0.22), ha=(0.009, 0.013), hb=(0.006, 0.009),
+                  blade_h=(0.016, 0.050), blade_t=(0.0015, 0.0025)),
+        variants=[dict(material="steel", materials={"handle": "wood_tang"}),
+                  dict(material="steel", materials={"handle": "plastic_tang"})])],
+    "screwdriver": [dict(family="screwdriver, wider", ranges=dict(
+        Lh=(0.07, 0.12), Ls=(0.05, 0.17), rh=(0.011, 0.018), rs=(0.0025, 0.0045)),
+        variants=[dict(material="steel", materials={"handle": "plastic"}, tip="cross"),
+                  dict(material="steel", materials={"handle": "wood"}, tip="flat"),
+                  dict(material="steel", materials={"handle": "plastic"}, tip="flat"),
+                  dict(material="steel", materials={"handle": "plastic"}, tip="cross")])],
+    "cooking_tool": [dict(family="ladle, wider", ranges=dict(
+        R=(0.035, 0.060), D=(0.035, 0.060), wall=(0.0010, 0.0015), L=(0.20, 0.30),
+        angle=(0.40, 0.70), lha=(0.007, 0.010), lhb=(0.002, 0.003)),
+        variants=[dict(material="steel", materials={}, kind="ladle"),
+                  dict(material="plastic", materials={}, kind="ladle")]),
+                     dict(family="spatula, wider", ranges=dict(
+                         Lh=(0.11, 0.17), Ln=(0.03, 0.07), Lhead=(0.07, 0.11),
+                         W=(0.055, 0.085), t=(0.002, 0.0035), ha=(0.009, 0.013),
+                         hb=(0.005, 0.008)),
+        variants=[dict(material="steel", materials={"handle": "wood"}, kind="spatula"),
+                  dict(material="plastic", materials={"handle": "plastic"}, kind="spatula")])],
+}
+
+
 def build(category: str, P: dict, variant: dict) -> Model:
+    shape = variant.get("shape")
+    if shape == "lidded_pot":
+        return make_lidded_pot(P, variant)
+    if shape == "stemmed_glass":
+        return make_stemmed_glass(P, variant)
     if category in ("pan", "pot", "cup", "glass", "bowl"):
         P = dict(P)
         if category == "pan":
@@ -1306,7 +1557,7 @@ def finish(obj_id: str, m: Model) -> dict:
     rho = MATERIALS[m.material][0]
     mp = mass_properties(V, F, rho, [(Vp, Fp, MATERIALS[mat][0]) for Vp, Fp, mat in m.pieces])
     poses = {}
-    for pose in POSES_OF[m.category]:
+    for pose in m.poses or POSES_OF[m.category]:
         if is_tool:  # lying flat on the face that defined the frame: X_TO is the identity
             n, margin = np.array(TOOL_DOWN), tool_margin
         else:
@@ -1321,7 +1572,7 @@ def finish(obj_id: str, m: Model) -> dict:
     labels = m.labels.astype(np.uint8)
     parts = [p for k, p in enumerate(PART_LABELS) if (labels == k).any()]
     lo, hi = V.min(0), V.max(0)
-    open_c = m.category in ("pan", "pot", "cup", "glass", "bowl")
+    open_c = m.category in ("pan", "pot", "cup", "glass", "bowl") and not m.closed_top
     widths = grasp_widths(V, labels, open_c, m.rim)
     entry = {
         "category": m.category,
@@ -1430,28 +1681,58 @@ def obj_text(obj_id, V, F) -> str:
     return head + f"o {obj_id}\n" + v + "\n" + vn + "\n" + f + "\n"
 
 
-def generate(out: Path, verbose=False) -> dict:
-    out.mkdir(parents=True, exist_ok=True)
-    library = {}
+def instances_a():
+    """(id, category, parameters, variant) of every object of set a, the shipped library."""
     for ci, cat in enumerate(CATEGORIES):
         rng = np.random.default_rng([SEED, ci])
         params = lhs(rng, N_PER_CATEGORY, RANGES[cat])
         for i in range(N_PER_CATEGORY):
-            obj_id = f"{cat}_{i + 1:02d}"
-            m = build(cat, params[i], VARIANTS[cat][i])
-            entry, V, F, labels, mp = finish(obj_id, m)
-            d = out / obj_id
-            d.mkdir(exist_ok=True)
-            (d / f"{obj_id}.obj").write_text(obj_text(obj_id, V, F))
-            (d / f"{obj_id}.sdf").write_text(sdf_text(obj_id, entry, mp))
-            with open(d / f"{obj_id}_parts.npy", "wb") as fh:
-                np.save(fh, labels)
-            entry.pop("color")
-            library[obj_id] = entry
-            if verbose:
-                print(f"{obj_id:16s} {entry['mass']:7.3f} kg  {len(F):5d} triangles  "
-                      f"poses {', '.join(entry['poses'])}")
-    header = ("# The object library, generated by tools/make_objects.py: do not edit.\n"
+            yield f"{cat}_{i + 1:02d}", cat, params[i], VARIANTS[cat][i]
+
+
+def instances_b():
+    """(id, category, parameters, variant) of every object of set b (FAMILIES_B)."""
+    for ci, cat in enumerate(CATEGORIES):
+        fams = FAMILIES_B[cat]
+        counts = [len(range(fi, N_PER_CATEGORY_B, len(fams))) for fi in range(len(fams))]
+        drawn = [lhs(np.random.default_rng([SEED_B, ci, fi]), k, fam["ranges"])
+                 for fi, (fam, k) in enumerate(zip(fams, counts, strict=True))]
+        for i in range(N_PER_CATEGORY_B):
+            fi, j = i % len(fams), i // len(fams)
+            fam = fams[fi]
+            variant = dict(fam["variants"][j % len(fam["variants"])], family=fam["family"])
+            if "shape" in fam:
+                variant["shape"] = fam["shape"]
+            yield f"{cat}_b{i + 1:02d}", cat, drawn[fi][j], variant
+
+
+SETS = {"a": dict(out=OUT, instances=instances_a, title="The object library"),
+        "b": dict(out=OUT.parent / "objects_b", instances=instances_b,
+                  title="Object set b (issue 20: another seed, wider shape families; "
+                        "a user library)")}
+
+
+def generate(out: Path, verbose=False, object_set: str = "a") -> dict:
+    out.mkdir(parents=True, exist_ok=True)
+    library = {}
+    spec = SETS[object_set]
+    for obj_id, cat, params, variant in spec["instances"]():
+        m = build(cat, params, variant)
+        entry, V, F, labels, mp = finish(obj_id, m)
+        if "family" in variant:
+            entry["family"] = variant["family"]
+        d = out / obj_id
+        d.mkdir(exist_ok=True)
+        (d / f"{obj_id}.obj").write_text(obj_text(obj_id, V, F))
+        (d / f"{obj_id}.sdf").write_text(sdf_text(obj_id, entry, mp))
+        with open(d / f"{obj_id}_parts.npy", "wb") as fh:
+            np.save(fh, labels)
+        entry.pop("color")
+        library[obj_id] = entry
+        if verbose:
+            print(f"{obj_id:16s} {entry['mass']:7.3f} kg  {len(F):5d} triangles  "
+                  f"poses {', '.join(entry['poses'])}")
+    header = (f"# {spec['title']}, generated by tools/make_objects.py: do not edit.\n"
               "# Units: metres, kilograms, kg/m³, kg·m². Object "
               "frame O: containers — origin at the\n"
               "# bottom centre, z along the symmetry axis towards "
@@ -1485,21 +1766,26 @@ def compare_trees(a: Path, b: Path) -> list[str]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", type=Path, default=OUT, help="output directory (default: %(default)s)")
+    ap.add_argument("--set", dest="object_set", choices=tuple(SETS), default="a",
+                    help="the object set: a, the shipped library (models/objects/); b, the second "
+                         "set with wider shape families (models/objects_b/)")
+    ap.add_argument("--out", type=Path, help="output directory (default: the set's folder)")
     ap.add_argument("--check", action="store_true",
                     help="regenerate into a temporary directory and compare bytes with --out")
     ap.add_argument("-v", "--verbose", action="store_true")
     args = ap.parse_args(argv)
+    if args.out is None:
+        args.out = SETS[args.object_set]["out"]
     if args.check:
         with tempfile.TemporaryDirectory() as tmp:
-            generate(Path(tmp), args.verbose)
+            generate(Path(tmp), args.verbose, args.object_set)
             diff = compare_trees(Path(tmp), args.out)
         if diff:
             print(f"{len(diff)} file(s) differ from {args.out}:", *diff[:20], sep="\n  ")
             return 1
         print(f"{args.out}: every file matches the generator")
         return 0
-    lib = generate(args.out, args.verbose)
+    lib = generate(args.out, args.verbose, args.object_set)
     print(f"wrote {len(lib)} objects to {args.out}")
     return 0
 

@@ -75,9 +75,11 @@ def plant_with_rest_table(builder: DiagramBuilder):
     return plant
 
 
-def rest_on_table(obj_id: str, pose: str) -> dict:
-    """Simulates the object resting on the table; returns what happened."""
-    obj = load_library()[obj_id]
+def rest_on_table(obj_id, pose: str) -> dict:
+    """Simulates the object (a shipped id, or a LibraryObject of any library) resting on the
+    table; returns what happened."""
+    obj = load_library()[obj_id] if isinstance(obj_id, str) else obj_id
+    obj_id = obj.id
     t0 = time.perf_counter()
     builder = DiagramBuilder()
     plant = plant_with_rest_table(builder)
@@ -112,7 +114,7 @@ def rest_on_table(obj_id: str, pose: str) -> dict:
 
 def check_rest(obj_id, pose):
     r = rest_on_table(obj_id, pose)
-    where = f"{obj_id} {pose}: {r}"
+    where = f"{getattr(obj_id, 'id', obj_id)} {pose}: {r}"
     assert r["drift"] < MAX_DRIFT, where
     assert r["tilt"] < MAX_TILT, where
     assert r["n_hydro"] == 1 and r["n_point"] == 0, where
