@@ -23,9 +23,8 @@ Invalid pixels are 0 (a RealSense's "no depth"; Drake's depth images use 0 for t
 +inf for too far: the perception stage skips both).
 
 The camera frame is Drake's: X right, Y down, Z forward; the image column u grows with X.
+(No `from __future__ import annotations` here: the scenario loader reads the field types.)
 """
-
-from __future__ import annotations
 
 from dataclasses import dataclass
 
@@ -205,3 +204,12 @@ def apply_sensor(depth: np.ndarray, intrinsics: Intrinsics, model: SensorModel, 
     out[valid & ((out < model.min_range) | (out > model.max_range))] = 0.0
     out[lost] = 0.0
     return out.astype(np.float32).reshape(shape)
+
+
+def capture_index(t: float, fps: float, offset: float = 0.0) -> int:
+    """The index of the latest frame a camera running at `fps` [Hz] from time `offset` [s] has
+    captured by time `t` [s] (0 before the first; a millionth of a period of slack, so that a
+    frame's own time counts as captured)."""
+    if not fps > 0:
+        raise PerceptionError(f"a camera's frame rate must be > 0 Hz, got {fps}")
+    return max(0, int(np.floor((t - offset) * fps + 1e-6)))
