@@ -40,6 +40,7 @@ from tg_drake.grasping.model import load_model
 from tg_drake.objects import box_centre
 from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario
 from tg_drake.station import Station, add_station, placement_pose
+from tg_drake.systems.depth_noise import DepthNoise
 from tg_drake.systems.dgi_system import DgiScoringSystem
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.kernel_prior_system import KernelPriorSystem
@@ -114,8 +115,14 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
             seed=perception_config.segmentation.seed + scenario.random_seed))
         perception = builder.AddNamedSystem("perception", PerceptionSystem(
             camera_info=station.cameras[camera].info, config=perception_config))
-        builder.Connect(station.outputs[f"{camera}.depth_image"],
-                        perception.GetInputPort("depth_image"))
+        # The camera's measurement of the rendered depth (perception.sensor), seeded by the
+        # scenario's random_seed and the frame's capture index.
+        camera_config = scenario.cameras[camera]
+        depth_noise = builder.AddNamedSystem("depth_noise", DepthNoise(
+            station.cameras[camera].info, config.perception.sensor, seed=scenario.random_seed,
+            fps=camera_config.fps, capture_offset=camera_config.capture_offset))
+        builder.Connect(station.outputs[f"{camera}.depth_image"], depth_noise.get_input_port())
+        builder.Connect(depth_noise.get_output_port(), perception.GetInputPort("depth_image"))
         builder.Connect(station.outputs[f"{camera}.camera_pose"],
                         perception.GetInputPort("camera_pose"))
     else:

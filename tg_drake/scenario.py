@@ -40,6 +40,7 @@ from tg_drake.logic.engine import LogicQueryConfig
 from tg_drake.models import models_root
 from tg_drake.objects import PACKAGE, add_library, get_object, mesh, register_object
 from tg_drake.perception.config import PerceptionConfig
+from tg_drake.perception.sensor_model import IdealDepth, SensorModel, StructuredLight
 from tg_drake.planning.planner import PlannerConfig
 from tg_drake.robot import WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
 from tg_drake.robot_plants import default_directives
@@ -197,6 +198,9 @@ class DepthPerception:
 
     camera: str = "camera0"  # which of the scenario's `cameras` perception looks through
     config: PerceptionConfig = field(default_factory=PerceptionConfig)  # every step's parameters
+    sensor: SensorModel = field(default_factory=IdealDepth)  # what the camera measures of the
+    # rendered depth: `!IdealDepth {}` (the render as it is) or `!StructuredLight {...}` (a
+    # triangulating camera's noise and missing pixels; defaults: an Intel RealSense D415)
 
 
 @dataclass
@@ -293,6 +297,10 @@ class PipelineConfig:
         if isinstance(self.perception, DepthPerception) and not self.perception.camera:
             raise ScenarioError("perception needs a camera name",
                                 field=f"{where}.perception.camera")
+        if isinstance(self.perception, DepthPerception) and isinstance(self.perception.sensor,
+                                                                      StructuredLight):
+            for f, problem in self.perception.sensor.validate(f"{where}.perception.sensor"):
+                raise ScenarioError(problem, field=f)
         if isinstance(self.perception, GroundTruthPerception) and not self.perception.spacing > 0:
             raise ScenarioError(f"spacing must be > 0 [m], got {self.perception.spacing}",
                                 field=f"{where}.perception.spacing")

@@ -32,8 +32,10 @@ from tg_drake.logic.theory import TheoryConfig
 from tg_drake.objects import get_object, mesh
 from tg_drake.perception.ground_truth import interior_visible
 from tg_drake.perception.render import perceive
+from tg_drake.perception.sensor_model import StructuredLight
 from tg_drake.run import run_scenario
 from tg_drake.scenario import (
+    DepthPerception,
     DgiScorer,
     LocalOnly,
     PipelineConfig,
@@ -64,6 +66,9 @@ METHODS = {
 PRIOR_FLOOR = 0.02  # the pipeline's (PipelineConfig.prior_floor): a prior that misses the true
 # category cannot make perceived evidence impossible.
 CONFIDENT_PART = 0.5  # S_REAL: detected parts at least this likely are kept (as certain).
+# The depth sensor the perceived and executed suites see: a realistic camera's measurement of the
+# render (tg_drake.perception.sensor_model; a scenario's own default is the exact render).
+EVALUATION_SENSOR = StructuredLight()
 
 
 @functools.cache
@@ -170,7 +175,8 @@ def run_perceived(case) -> list[dict]:
     obj = get_object(placement.id)
     meta = case.meta()
     try:
-        d = perceive(obj.id, placement.pose, placement.yaw)
+        d = perceive(obj.id, placement.pose, placement.yaw, sensor=EVALUATION_SENSOR,
+                     seed=_seed(case.key, case.seed))
         detection = {"found_pose": d.pose, "found_parts": sorted(
             p for p, v in d.part_probabilities.items() if v > 0)}
         priors = kernel_priors(d.p_W, d.n_W, d.labels, object_id=obj.id, t=case.kernel_T)
@@ -195,7 +201,8 @@ def run_perceived(case) -> list[dict]:
 
 def scenario_of(case) -> Scenario:
     """The scenario an executed case runs (validated)."""
-    pipeline = PipelineConfig(scoring=LocalOnly() if case.variant == "local" else DgiScorer())
+    pipeline = PipelineConfig(perception=DepthPerception(sensor=EVALUATION_SENSOR),
+                              scoring=LocalOnly() if case.variant == "local" else DgiScorer())
     pipeline.logic.category = pipeline.logic.grasp = case.theory
     pipeline.logic.use_prior = case.variant != "pipeline_uniform"
     scenario = Scenario(objects=list(case.objects), pipeline=pipeline,
