@@ -44,7 +44,9 @@ from pydrake.geometry import (
     AddContactMaterial,
     AddRigidHydroelasticProperties,
     Box,
+    CollisionFilterDeclaration,
     GeometryInstance,
+    GeometrySet,
     MakePhongIllustrationProperties,
     MakeRenderEngineGl,
     PerceptionProperties,
@@ -65,6 +67,7 @@ from pydrake.multibody.parsing import (
 )
 from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import (
+    BodyIndex,
     JointActuatorIndex,
     ModelInstanceIndex,
     PdControllerGains,
@@ -267,6 +270,15 @@ def add_spheres(plant: MultibodyPlant, instance: ModelInstanceIndex, prefix: str
     return tuple(bodies)
 
 
+def exclude_mutual_contact(plant: MultibodyPlant, scene_graph: SceneGraph,
+                           contents: list[ContentsModel]) -> None:
+    """Filters contact between any two spheres (after Finalize)."""
+    bodies = [plant.get_body(BodyIndex(b)) for m in contents for b in m.bodies]
+    geometries = GeometrySet([g for b in bodies for g in plant.GetCollisionGeometriesForBody(b)])
+    scene_graph.collision_filter_manager().Apply(
+        CollisionFilterDeclaration().ExcludeWithin(geometries))
+
+
 def _add_sphere_contents(plant: MultibodyPlant, placement: ObjectPlacement, obj,
                          X_WO: RigidTransform, config: ContentsConfig) -> ContentsModel:
     """A "full" container's water as free spheres packed in its cavity, of the water's total
@@ -396,6 +408,8 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
 
     station = Station(scenario=scenario, plant=plant, scene_graph=scene_graph,
                       instances=instances, objects=objects, cameras={}, contents=contents)
+    if contents and not scenario.contents.mutual:
+        exclude_mutual_contact(plant, scene_graph, contents)
     if scenario.dispenser is not None:
         command = builder.AddNamedSystem("dispenser_command",
                                          DispenserCommand(gate_travel(scenario.dispenser)))

@@ -8,27 +8,14 @@ while its gate is closed. Counts are those of `count_contents`, the task check's
 
 import numpy as np
 import pytest
-from pydrake.math import RigidTransform
-from pydrake.multibody.plant import AddMultibodyPlant
-from pydrake.multibody.tree import (
-    BodyIndex,
-    FixedOffsetFrame,
-    PdControllerGains,
-    RevoluteJoint,
-    SpatialInertia,
-)
+from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import TrajectorySource
-from pydrake.trajectories import PiecewisePolynomial
 
-from tg_drake.models import make_parser
-from tg_drake.objects import WATER_DENSITY, get_object, mesh
-from tg_drake.scenario import default_plant_config, load_scenario
-from tg_drake.station import add_spheres, make_station
-from tg_drake.table import TABLE_SIZE, add_table
-from tg_drake.tasks.contents import ContentsConfig, ContentsModel, container_sites, \
-    count_contents
+from tg_drake.objects import WATER_DENSITY, get_object
+from tg_drake.scenario import load_scenario
+from tg_drake.simulation.pour import tilt_rig
+from tg_drake.station import make_station
+from tg_drake.tasks.contents import ContentsConfig, count_contents
 
 CUP = "cup_01"
 BOWL = "bowl_01"
@@ -83,72 +70,28 @@ cameras: {{}}
     assert station.plant.HasBodyNamed(f"{CUP}_contents")
 
 
-def pour_rig(obj_id: str, config: ContentsConfig, *, pivot_height: float = 0.25,
-             turn: float = np.pi, duration: float = 1.0):
-    """A plant with the table, the container welded to a link on a revolute joint about the
-    world x axis through a point `pivot_height` [m] above the table's centre (the container's
-    base 5 cm below it), and its spheres; the joint follows a ramp from 0 to `turn` [rad] over
-    `duration` [s] through the plant's PD control (gravity off for the rig and the container, as
-    if a robot held it)."""
-    builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlant(default_plant_config(), builder)
-    X_WT = RigidTransform([0.75, 0.0, 0.0])
-    add_table(plant, TABLE_SIZE, X_WT)
-    obj = get_object(obj_id)
-    (instance,) = make_parser(plant).AddModels(url=obj.sdf_url)
-    body = plant.get_body(plant.GetBodyIndices(instance)[0])
-    link = plant.AddRigidBody("rig_link", instance, SpatialInertia.SolidBoxWithMass(
-        1.0, 0.05, 0.05, 0.05))
-    X_WP = RigidTransform(X_WT.translation() + [0.0, 0.0, pivot_height])
-    pivot = plant.AddFrame(FixedOffsetFrame("rig_pivot", plant.world_frame(), X_WP))
-    joint = plant.AddJoint(RevoluteJoint("rig_joint", pivot, link.body_frame(), [1.0, 0.0, 0.0]))
-    X_LO = RigidTransform([0.0, 0.0, -0.05])
-    plant.WeldFrames(link.body_frame(), body.body_frame(), X_LO)
-    actuator = plant.AddJointActuator("rig_actuator", joint, 200.0)
-    actuator.set_controller_gains(PdControllerGains(p=200.0, d=20.0))
-    plant.set_gravity_enabled(instance, False)
-    V, F = mesh(obj)[:2]
-    p_O = container_sites(obj.id, V, F, config)
-    p_W = p_O + (X_WP @ X_LO).translation()
-    spheres = plant.AddModelInstance("spheres")
-    bodies = add_spheres(plant, spheres, "sphere", p_W, config.radius,
-                         WATER_DENSITY * obj.cavity_volume / len(p_O), config)
-    plant.Finalize()
-    ramp = PiecewisePolynomial.FirstOrderHold([0.0, duration, duration + 100.0],
-                                              [[0.0, turn, turn]])
-    source = builder.AddSystem(TrajectorySource(ramp, output_derivative_order=1))
-    builder.Connect(source.get_output_port(), plant.get_desired_state_input_port(instance))
-    diagram = builder.Build()
-    return diagram, plant, body, ContentsModel(obj.id, bodies, config.radius)
-
-
-def _rig_counts(diagram, plant, body, model, context):
-    plant_context = plant.GetMyContextFromRoot(context)
-    poses = plant.get_body_poses_output_port().Eval(plant_context)
-    X_WO = plant.EvalBodyPoseInWorld(plant_context, body)
-    return count_contents(model, poses, containers={model.name: (X_WO, get_object(model.name))},
-                          table_z=0.0)
+def _rig_counts(rig, simulator):
+    return rig.counts(simulator.get_mutable_context())
 
 
 @pytest.mark.slow
 def test_a_cup_turned_upside_down_pours_every_sphere_onto_the_table():
-    diagram, plant, body, model = pour_rig(CUP, ContentsConfig(model="spheres"))
-    simulator = Simulator(diagram)
-    context = simulator.get_mutable_context()
-    assert _rig_counts(diagram, plant, body, model, context)[CUP] == len(model.bodies)
+    rig = tilt_rig(CUP, ContentsConfig(model="spheres"))
+    simulator = Simulator(rig.diagram)
+    n = len(rig.model.bodies)
+    assert _rig_counts(rig, simulator) == {CUP: n, "table": 0, "floor": 0, "elsewhere": 0}
     simulator.AdvanceTo(2.5)
-    counts = _rig_counts(diagram, plant, body, model, context)
-    assert counts == {CUP: 0, "table": len(model.bodies), "floor": 0, "elsewhere": 0}
+    assert _rig_counts(rig, simulator) == {CUP: 0, "table": n, "floor": 0, "elsewhere": 0}
 
 
+@pytest.mark.slow
 def test_a_cup_tilted_short_of_its_rim_keeps_every_sphere():
     # 30° from upright: the spheres' level stays below the rim.
-    diagram, plant, body, model = pour_rig(CUP, ContentsConfig(model="spheres"),
-                                           turn=np.deg2rad(30.0), duration=0.5)
-    simulator = Simulator(diagram)
+    rig = tilt_rig(CUP, ContentsConfig(model="spheres"), turn=np.deg2rad(30.0), duration=0.5)
+    simulator = Simulator(rig.diagram)
     simulator.AdvanceTo(1.0)
-    counts = _rig_counts(diagram, plant, body, model, simulator.get_mutable_context())
-    assert counts == {CUP: len(model.bodies), "table": 0, "floor": 0, "elsewhere": 0}
+    n = len(rig.model.bodies)
+    assert _rig_counts(rig, simulator) == {CUP: n, "table": 0, "floor": 0, "elsewhere": 0}
 
 
 def _dispenser_scenario():

@@ -21,7 +21,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from tg_drake.errors import ScenarioError
-from tg_drake.objects import WATER_DENSITY
 from tg_drake.objects import mesh as object_mesh
 
 CONTENTS_MODELS = ("mass", "spheres")
@@ -29,7 +28,7 @@ CONTENTS_MODELS = ("mass", "spheres")
 # Defaults chosen by measurement (tests/integration/test_contents.py, the report of issue 21:
 # wall time per simulated second of a full cup, spill and tunnelling in the pour rig).
 SPHERE_RADIUS = 0.008  # [m] measured
-MAX_SPHERES = 40  # [1] measured: a fill at most this many spheres (the lowest lattice sites)
+MAX_SPHERES = 20  # [1] measured: a fill at most this many spheres (the lowest lattice sites)
 SPHERE_MODULUS = 1e7  # [Pa] hydroelastic modulus, measured
 SPHERE_RESOLUTION = 0.016  # [m] hydroelastic mesh resolution hint (a coarse sphere), measured
 SPHERE_DISSIPATION = 5.0  # [s/m] Hunt–Crossley dissipation, measured (little bounce)
@@ -41,6 +40,7 @@ LATTICE_GAP = 0.05  # [1] lattice spacing = 2·radius·(1 + gap): spheres start 
 CLEARANCE = 1.1  # [1] a start site is at least this many radii from the container's mesh
 ON_TABLE = 3.0  # [radii] a sphere's centre this near the table top lies on the table or on spheres
 # lying on it (one resting in the groove between two stands 2.7 radii high)
+_PAIRS = 400_000  # ray-triangle pairs per vectorised batch (memory: ~10 MB per array)
 _HORIZONTAL = 12  # rays in O's xy plane for the enclosure test
 
 
@@ -58,6 +58,8 @@ class ContentsConfig:
     resolution_hint: float = SPHERE_RESOLUTION  # [m] hydroelastic mesh resolution of a sphere
     dissipation: float = SPHERE_DISSIPATION  # [s/m] Hunt–Crossley dissipation
     friction: float = SPHERE_FRICTION  # [1] Coulomb friction (static = dynamic)
+    mutual: bool = True  # the spheres touch each other (False: each touches only the rest of
+    # the world, a cheaper fluid that keeps no volume)
 
     def validate(self, where: str = "contents") -> None:
         if self.model not in CONTENTS_MODELS:
@@ -150,8 +152,8 @@ def _check_count(value, field: str, *, positive: bool = False) -> None:
 # Ray casting on a triangle mesh (Möller–Trumbore), vectorised over points for one direction.
 
 
-def _ray_hits(origins: np.ndarray, direction: np.ndarray, V: np.ndarray, F: np.ndarray,
-              chunk: int = 128) -> tuple[np.ndarray, np.ndarray]:
+def _ray_hits(origins: np.ndarray, direction: np.ndarray, V: np.ndarray, F: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray]:
     """(first hit distance (n,) [m], inf when none; number of hits (n,)) of rays from `origins`
     along the unit `direction` on the triangles F of V."""
     A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
@@ -165,6 +167,7 @@ def _ray_hits(origins: np.ndarray, direction: np.ndarray, V: np.ndarray, F: np.n
     hits = np.zeros(len(origins), int)
     if len(A) == 0:
         return first, hits
+    chunk = max(1, _PAIRS // len(A))  # rays per batch, bounding the (rays × triangles) arrays
     for s in range(0, len(origins), chunk):
         T = origins[s:s + chunk, None, :] - A[None]
         u = np.einsum("nmk,mk->nm", T, p) * inv
@@ -368,9 +371,10 @@ def count_contents(model: ContentsModel, body_poses, *,
 
     A sphere is in the first container whose cavity encloses its centre (`enclosed`, in that
     container's frame); else on the table when its centre is within ON_TABLE radii above the
-    table top `table_z` [m, world z] (on it, or on spheres lying on it); on the floor when below the table top (it fell off); elsewhere
-    otherwise (in the air, in the hopper, on the gripper, on another object). `mesh_of(obj)` gives
-    (V, F, ...) of a container (tg_drake.objects.mesh by default)."""
+    table top `table_z` [m, world z] (on it, or on spheres lying on it); on the floor when below
+    the table top (it fell off); elsewhere otherwise (in the air, in the hopper, on the gripper,
+    on another object). `mesh_of(obj)` gives (V, F, ...) of a container (tg_drake.objects.mesh
+    by default)."""
     p_W = np.array([_translation(body_poses[int(b)]) for b in model.bodies]).reshape(-1, 3)
     counts = {name: 0 for name in containers}
     counts.update(table=0, floor=0, elsewhere=0)
