@@ -273,7 +273,10 @@ def cavity_sites(V: np.ndarray, F: np.ndarray, radius: float,
     lo, hi = V.min(axis=0) + radius, V.max(axis=0) - radius
     floor = _floor(V, F)
     z0 = lo[2] if floor is None else max(lo[2], floor + CLEARANCE * radius)
-    layer = _lattice(np.array([lo[0], lo[1], 0.0]), np.array([hi[0], hi[1], 0.0]), spacing)
+    # Centred on O's z axis (a container's symmetry axis), over the mesh's whole width.
+    half = np.maximum(np.abs(lo[:2]), np.abs(hi[:2]))
+    layer = _lattice(np.array([-half[0], -half[1], 0.0]), np.array([half[0], half[1], 0.0]),
+                     spacing)
     sites = []
     z = z0
     while z <= hi[2] and (max_sites is None or len(sites) < max_sites):
