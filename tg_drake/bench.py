@@ -32,6 +32,7 @@ FIGURES: dict[str, str] = {
     "pipeline_rtf": "tg_drake.run:bench_pipeline_rtf",
     "import_s": "tg_drake.importing.bench:import_s",
     "scan_run_ratio": "tg_drake.run:bench_scan_run_ratio",
+    "pour_run_ratio": "tg_drake.simulation.pour:bench_pour_run_ratio",
 }
 
 

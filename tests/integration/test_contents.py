@@ -1,0 +1,119 @@
+"""Contents as spheres in physics: every sphere accounted for, none through a wall.
+
+A full cup standing on the table keeps its spheres; the same cup turned upside down above the
+table by a test rig (the cup welded to a link on a PD-driven revolute joint) pours them all onto
+the table; the dispenser drops its spheres into an empty bowl standing below it, and keeps them
+while its gate is closed. Counts are those of `count_contents`, the task check's.
+"""
+
+import numpy as np
+import pytest
+from pydrake.multibody.tree import BodyIndex
+from pydrake.systems.analysis import Simulator
+
+from tg_drake.objects import WATER_DENSITY, get_object
+from tg_drake.scenario import load_scenario
+from tg_drake.simulation.pour import tilt_rig
+from tg_drake.station import make_station
+from tg_drake.tasks.contents import ContentsConfig, count_contents
+
+CUP = "cup_01"
+BOWL = "bowl_01"
+
+
+def _hold_robot(diagram, station, context):
+    plant_context = station.plant.GetMyContextFromRoot(context)
+    q = station.plant.GetPositions(plant_context, station.instances["iiwa"])
+    diagram.GetInputPort("iiwa.desired_state").FixValue(context, np.concatenate([q, 0 * q]))
+    diagram.GetInputPort("wsg.position").FixValue(context, [0.1])
+
+
+def _station_counts(diagram, station, context, containers):
+    plant = station.plant
+    plant_context = plant.GetMyContextFromRoot(context)
+    poses = diagram.GetOutputPort("body_poses").Eval(context)
+    where = {name: (plant.EvalBodyPoseInWorld(plant_context, station.object_body(name)),
+                    get_object(obj_id)) for name, obj_id in containers.items()}
+    return [count_contents(m, poses, containers=where, table_z=0.0) for m in station.contents]
+
+
+def test_a_full_cup_standing_for_1_s_keeps_every_sphere():
+    scenario = load_scenario(scenario_text=f"""
+objects: [{{id: {CUP}, xy: [0.0, 0.2], containment: full}}]
+contents: {{model: spheres}}
+cameras: {{}}
+""")
+    diagram, station = make_station(scenario)
+    (model,) = station.contents
+    assert model.name == CUP and len(model.bodies) > 0
+    # The spheres weigh what the water does.
+    plant = station.plant
+    mass = sum(plant.get_body(BodyIndex(b)).default_mass() for b in model.bodies)
+    assert mass == pytest.approx(WATER_DENSITY * get_object(CUP).cavity_volume, rel=1e-9)
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    _hold_robot(diagram, station, context)
+    (before,) = _station_counts(diagram, station, context, {CUP: CUP})
+    assert before[CUP] == len(model.bodies)
+    simulator.AdvanceTo(1.0)
+    (after,) = _station_counts(diagram, station, context, {CUP: CUP})
+    assert after == {CUP: len(model.bodies), "table": 0, "floor": 0, "elsewhere": 0}
+
+
+def test_the_mass_model_adds_no_spheres():
+    scenario = load_scenario(scenario_text=f"""
+objects: [{{id: {CUP}, xy: [0.0, 0.2], containment: full}}]
+cameras: {{}}
+""")
+    _, station = make_station(scenario)
+    assert station.contents == []
+    assert station.plant.HasBodyNamed(f"{CUP}_contents")
+
+
+def _rig_counts(rig, simulator):
+    return rig.counts(simulator.get_mutable_context())
+
+
+@pytest.mark.slow
+def test_a_cup_turned_upside_down_pours_every_sphere_onto_the_table():
+    rig = tilt_rig(CUP, ContentsConfig(model="spheres"))
+    simulator = Simulator(rig.diagram)
+    n = len(rig.model.bodies)
+    assert _rig_counts(rig, simulator) == {CUP: n, "table": 0, "floor": 0, "elsewhere": 0}
+    simulator.AdvanceTo(2.5)
+    assert _rig_counts(rig, simulator) == {CUP: 0, "table": n, "floor": 0, "elsewhere": 0}
+
+
+@pytest.mark.slow
+def test_a_cup_tilted_short_of_its_rim_keeps_every_sphere():
+    # 30° from upright: the spheres' level stays below the rim.
+    rig = tilt_rig(CUP, ContentsConfig(model="spheres"), turn=np.deg2rad(30.0), duration=0.5)
+    simulator = Simulator(rig.diagram)
+    simulator.AdvanceTo(1.0)
+    n = len(rig.model.bodies)
+    assert _rig_counts(rig, simulator) == {CUP: n, "table": 0, "floor": 0, "elsewhere": 0}
+
+
+def _dispenser_scenario():
+    return load_scenario(scenario_text=f"""
+objects: [{{id: {BOWL}, xy: [0.1, 0.3]}}]
+dispenser: {{xy: [0.1, 0.3], height: 0.15, count: 12}}
+cameras: {{}}
+""")
+
+
+@pytest.mark.parametrize("open_gate", [True, False])
+def test_the_dispenser_drops_its_spheres_into_the_bowl_below_only_when_open(open_gate):
+    diagram, station = make_station(_dispenser_scenario())
+    (model,) = station.contents
+    assert model.name == "dispenser" and len(model.bodies) == 12
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    _hold_robot(diagram, station, context)
+    diagram.GetInputPort("dispenser.open").FixValue(context, [1.0 if open_gate else 0.0])
+    simulator.AdvanceTo(1.5)
+    (counts,) = _station_counts(diagram, station, context, {BOWL: BOWL})
+    if open_gate:
+        assert counts == {BOWL: 12, "table": 0, "floor": 0, "elsewhere": 0}
+    else:
+        assert counts == {BOWL: 0, "table": 0, "floor": 0, "elsewhere": 12}
