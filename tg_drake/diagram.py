@@ -188,6 +188,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     for name in ("wsg.state", "body_poses", "contact_results"):
         builder.Connect(station.outputs[name], supervisor.GetInputPort(name))
     builder.Connect(supervisor.GetOutputPort("collisions"), logic.GetInputPort("collisions"))
+    builder.Connect(supervisor.GetOutputPort("no_hold"), logic.GetInputPort("no_hold"))
     builder.Connect(supervisor.GetOutputPort("plan_request"), planner.GetInputPort("plan_request"))
 
     ports = {"scene_description": scene,
@@ -197,6 +198,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
              "ranked_grasps": ranked,
              "plan_status": planner.GetOutputPort("plan_status"),
              "collisions": supervisor.GetOutputPort("collisions"),
+             "no_hold": supervisor.GetOutputPort("no_hold"),
              "plan_request": supervisor.GetOutputPort("plan_request"),
              "outcome": supervisor.GetOutputPort("outcome")}
     return Pipeline(station=station, perception=perception, target=target, prior=prior,
