@@ -37,8 +37,9 @@ from tg_drake.grasping.feasibility import (
     HoldModel,
     grasp_feasibility,
     hold_feature_vector,
+    hull_volume,
 )
-from tg_drake.objects import load_library
+from tg_drake.objects import load_library, mesh
 from tg_drake.simulation.episode import TABLE_TOP_Z, EpisodeConfig, run_grasp_batch
 
 # Until objset's split (scenarios/suites/split.yaml) lands: the shipped `*_04` objects are held out.
@@ -103,7 +104,19 @@ def main(argv=None) -> int:
     return fit(args, argv)
 
 
-def episode_features(records: list[dict], config: FeasibilityConfig
+def hull_densities(ids) -> dict[str, float]:
+    """[kg/m³] per category: the median over the objects `ids` of mass / the convex-hull volume
+    of their mesh (the volume perception sees)."""
+    lib = load_library()
+    by_cat: dict[str, list[float]] = {}
+    for oid in ids:
+        obj = lib[oid]
+        V = np.asarray(mesh(obj)[0], float)
+        by_cat.setdefault(obj.category, []).append(obj.mass / hull_volume(V))
+    return {c: float(np.median(v)) for c, v in sorted(by_cat.items())}
+
+
+def episode_features(records: list[dict], config: FeasibilityConfig, densities: dict
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(F, y, object ids, refused) of the episodes with a label: F (n, len(FEATURES)) the hold
     features of each grasp on its scene's cloud, y 1 where it held, and whether the stage refuses
@@ -123,7 +136,8 @@ def episode_features(records: list[dict], config: FeasibilityConfig
                               table_z=TABLE_TOP_Z, approach=EpisodeConfig().approach_distance,
                               category={obj.category: 1.0},
                               config=dataclasses.replace(config, min_p_hold=0.0),
-                              model=_NEUTRAL)
+                              model=dataclasses.replace(
+                                  _NEUTRAL, meta={"hull_density_kg_m3": densities}))
         for r, h, c in zip(rs, f.holds, f.collisions, strict=True):
             F.append(hold_feature_vector(h))
             y.append(bool(r["success"]))
@@ -160,8 +174,11 @@ def fit(args, argv) -> int:
     from sklearn.linear_model import LogisticRegression
 
     records = read_records(args.episodes)
-    F, y, ids, hit = episode_features(records, FeasibilityConfig())
-    train_ids, held_ids = split_ids(sorted(set(ids)))
+    train_ids, held_ids = split_ids(sorted(load_library()))
+    densities = hull_densities(train_ids)
+    F, y, ids, hit = episode_features(records, FeasibilityConfig(), densities)
+    train_ids = [i for i in train_ids if i in set(ids)]
+    held_ids = [i for i in held_ids if i in set(ids)]
     train = np.isin(ids, train_ids) & ~hit
     held = np.isin(ids, held_ids) & ~hit
     mean, scale = F[train].mean(axis=0), F[train].std(axis=0) + 1e-9
@@ -175,6 +192,7 @@ def fit(args, argv) -> int:
         "episodes": {"total": int(len(y)), "held": int(y.sum()), "refused": int(hit.sum()),
                      "refused_that_held": int(y[hit].sum())},
         "train_objects": train_ids, "held_out_objects": held_ids,
+        "hull_density_kg_m3": densities,
     }
     model = HoldModel(FEATURES, mean, scale, lr.coef_[0], float(lr.intercept_[0]), meta)
     p_train = model.predict_proba(F[train])

@@ -14,9 +14,9 @@ fingers close along ±x_G, approach along +y_G, z_G across the pads):
 (b) hold margin — contact mechanics: the points between the pads that the closing pads reach
     first are the contact patches (area, extent, centre); the pads' Coulomb friction μ
     (tg_drake.robot.WSG_PAD_FRICTION and the object's), the normal force (the grip, capped by the
-    WSG's force limit), the object's mass (its perceived convex-hull volume × the density prior of
-    tg_drake.importing.mass, weighted by the logic's category distribution), and the lever of its
-    weight about the closing axis give the wrench the patches must carry under the lift and carry
+    WSG's force limit), the object's mass (its perceived convex-hull volume × a density per
+    category — the training objects' mass / hull volume, shipped with the hold model — weighted by
+    the logic's category distribution) and the lever of its weight about the closing axis give the wrench the patches must carry under the lift and carry
     accelerations and the wrench they can carry: a translational, a torsional and a combined
     margin (elliptic limit surface: margin < 1 slips).
 (c) P(hold | features) — a logistic regression on the margins and patch features, fitted on
@@ -36,7 +36,6 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from tg_drake.errors import ModelError, ScenarioError
-from tg_drake.importing.mass import density_prior
 from tg_drake.robot import (
     WSG_BODY_CENTRE_G,
     WSG_BODY_SIZE,
@@ -75,7 +74,8 @@ class FeasibilityConfig:
     patch_cell: float = 0.004  # [m] cells of a patch's area (perception's voxel).
     lift_acceleration: float = 2.0  # [m/s²] upwards, at the lift (a design load).
     carry_acceleration: float = 3.0  # [m/s²] horizontal, any direction, while carried.
-    default_density: float = 500.0  # [kg/m³] when no category distribution is given.
+    default_density: float = 500.0  # [kg/m³] of convex-hull volume, when no category
+    # distribution is given (the hold model's per-category densities otherwise).
     min_p_hold: float = 0.5  # a candidate more likely to slip than to hold (P(hold) below this)
     # gets score 0, "would not hold".
     model: str = ""  # a hold-model JSON file (tools/fit_hold_model.py); "" = the shipped one.
@@ -237,21 +237,18 @@ def hold_feature_vector(h: Hold) -> np.ndarray:
                      h.width / WSG_MAX_OPENING, h.pad_cut * 1e3, h.housing_cut * 1e3])
 
 
-def mean_density(category: dict[str, float] | None, default: float) -> float:
-    """[kg/m³] the density prior (tg_drake.importing.mass.density_prior) weighted by a category
-    distribution (name → probability); `default` when none is given."""
+def mean_density(category: dict[str, float] | None, densities: dict[str, float],
+                 default: float) -> float:
+    """[kg/m³] the per-category densities (category → kg/m³ of convex-hull volume) weighted by a
+    category distribution (name → probability); `default` when none is given or known."""
     if not category:
         return default
-    w = np.array([max(float(category.get(c, 0.0)), 0.0) for c in CATEGORIES])
+    w = np.array([max(float(category.get(c, 0.0)), 0.0) if c in densities else 0.0
+                  for c in CATEGORIES])
     if w.sum() <= 0:
         return default
-    return float(w @ _densities() / w.sum())
-
-
-@functools.cache
-def _densities() -> np.ndarray:
-    """[kg/m³] each category's density prior (reads the library's meshes: once)."""
-    return np.array([density_prior(c) for c in CATEGORIES])
+    rho = np.array([densities.get(c, 0.0) for c in CATEGORIES])
+    return float(w @ rho / w.sum())
 
 
 def hull_volume(p_W: np.ndarray) -> float:
@@ -344,6 +341,13 @@ class HoldModel:
     bias: float
     meta: dict
 
+    @property
+    def densities(self) -> dict[str, float]:
+        """[kg/m³] per category: the training objects' median mass / convex-hull volume (the
+        volume perception can see: the importing prior's mass / enclosed volume is the walls'
+        material for an open container's closed-wall mesh, not comparable)."""
+        return dict(self.meta.get("hull_density_kg_m3", {}))
+
     def predict_proba(self, F: np.ndarray) -> np.ndarray:
         """(n,) P(hold) for features F (n, len(features))."""
         z = ((np.atleast_2d(F) - self.mean) / self.scale) @ self.weights + self.bias
@@ -398,7 +402,8 @@ def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: n
     model = model or (load_hold_model(config.model) if config.model else _shipped_model())
     target_p_W = np.asarray(target_p_W, float).reshape(-1, 3)
     others_p_W = np.asarray(others_p_W, float).reshape(-1, 3)
-    mass = hull_volume(target_p_W) * mean_density(category, config.default_density)
+    mass = hull_volume(target_p_W) * mean_density(category, model.densities,
+                                                  config.default_density)
     p, reasons, holds, hits = [], [], [], []
     for X in np.asarray(X_WG, float).reshape(-1, 4, 4):
         h = hold(X, target_p_W=target_p_W, mass=mass, config=config, approach=approach)
