@@ -145,6 +145,11 @@ def penetration(X_WG: np.ndarray, p_W: np.ndarray, boxes, k: int) -> dict[str, f
     if len(p_W) < k:
         return out
     p_G = (np.asarray(p_W, float) - X_WG[:3, 3]) @ X_WG[:3, :3]
+    lo = np.min([c - h for _, c, h in boxes], axis=0)
+    hi = np.max([c + h for _, c, h in boxes], axis=0)
+    p_G = p_G[np.all((p_G >= lo) & (p_G <= hi), axis=1)]  # only points inside some box count
+    if len(p_G) < k:
+        return out
     for name, c, h in boxes:
         depth = -box_signed_distance(p_G - c, h)
         out[name] = max(out[name], float(max(np.partition(depth, -k)[-k], 0.0)))
