@@ -5,9 +5,9 @@
     diagram = builder.Build()
 
 The same builder is the public way to compose our systems with your own: `add_pipeline` returns
-every system it added (`pipeline.perception`, `.prior`, `.logic`, `.scoring`, `.planner`,
-`.supervisor` and the `station`), so you can add systems of yours to the same builder and connect
-them to any port — or call `add_station` alone and wire only the stages you want.
+every system it added (`pipeline.perception`, `.prior`, `.logic`, `.scoring`, `.feasibility`,
+`.planner`, `.supervisor` and the `station`), so you can add systems of yours to the same
+builder and connect them to any port — or call `add_station` alone and wire only the stages you want.
 
 Wiring (docs/design.md, "The diagram"):
 
@@ -15,7 +15,9 @@ Wiring (docs/design.md, "The diagram"):
         (latched: perceived at initialization and on a new perception_request, never live)
     scene_description ─▶ prior ─▶ category_prior
     scene_description, category_prior, task, collisions ─▶ logic ─▶ grasp_semantics
-    scene_description, grasp_semantics ─▶ scoring ─▶ ranked_grasps
+    scene_description, grasp_semantics ─▶ scoring ─▶ ranked_grasps (ports: scored_grasps)
+    scene_description, grasp_semantics, ranked_grasps ─▶ feasibility ─▶ ranked_grasps (the
+        poses that will be executed, with P(hold))
     scene_description, ranked_grasps, iiwa.state, plan_request ─▶ planner ─▶ iiwa.desired_state,
         wsg.position, plan_status
     scene_description, grasp_semantics, ranked_grasps, plan_status, wsg.state, body_poses,
@@ -42,6 +44,7 @@ from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario
 from tg_drake.station import Station, add_station, placement_pose
 from tg_drake.systems.depth_noise import DepthNoise
 from tg_drake.systems.dgi_system import DgiScoringSystem
+from tg_drake.systems.feasibility_system import GraspFeasibility
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.kernel_prior_system import KernelPriorSystem
 from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
@@ -85,6 +88,7 @@ class Pipeline:
     prior: LeafSystem
     logic: LeafSystem
     scoring: LeafSystem
+    feasibility: LeafSystem
     planner: LeafSystem
     supervisor: LeafSystem
     task: LeafSystem
@@ -158,11 +162,20 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     supervision = config.supervisor
     X_WT = scenario.X_WT.GetDeterministicValue()
     place_xy_W = (X_WT @ np.array([*scenario.task.place_xy, 0.0, 1.0]))[:2]
+    # Feasibility: the poses that will be executed, with P(hold); the planner plans them.
+    feasibility = builder.AddNamedSystem("feasibility", GraspFeasibility(
+        config.feasibility, approach=config.planner.pregrasp_distance))
+    builder.Connect(scene, feasibility.GetInputPort("scene_description"))
+    builder.Connect(logic.GetOutputPort("grasp_semantics"),
+                    feasibility.GetInputPort("grasp_semantics"))
+    builder.Connect(scoring.GetOutputPort("ranked_grasps"),
+                    feasibility.GetInputPort("ranked_grasps"))
+    ranked = feasibility.GetOutputPort("ranked_grasps")
     planner = builder.AddNamedSystem("planner", GraspPlanner(
         place_xy=place_xy_W, start_time=supervision.planning_start + supervision.period,
         config=config.planner, scenario=scenario))
     builder.Connect(scene, planner.GetInputPort("scene_description"))
-    builder.Connect(scoring.GetOutputPort("ranked_grasps"), planner.GetInputPort("ranked_grasps"))
+    builder.Connect(ranked, planner.GetInputPort("ranked_grasps"))
     builder.Connect(station.outputs["iiwa.state"], planner.GetInputPort("iiwa.state"))
     builder.Connect(planner.GetOutputPort("iiwa.desired_state"),
                     station.inputs["iiwa.desired_state"])
@@ -177,22 +190,25 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     builder.Connect(scene, supervisor.GetInputPort("scene_description"))
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     supervisor.GetInputPort("grasp_semantics"))
-    builder.Connect(scoring.GetOutputPort("ranked_grasps"),
-                    supervisor.GetInputPort("ranked_grasps"))
+    builder.Connect(ranked, supervisor.GetInputPort("ranked_grasps"))
     builder.Connect(planner.GetOutputPort("plan_status"), supervisor.GetInputPort("plan_status"))
     for name in ("wsg.state", "body_poses", "contact_results"):
         builder.Connect(station.outputs[name], supervisor.GetInputPort(name))
     builder.Connect(supervisor.GetOutputPort("collisions"), logic.GetInputPort("collisions"))
+    builder.Connect(supervisor.GetOutputPort("no_hold"), logic.GetInputPort("no_hold"))
     builder.Connect(supervisor.GetOutputPort("plan_request"), planner.GetInputPort("plan_request"))
 
     ports = {"scene_description": scene,
              "category_prior": prior.GetOutputPort("category_prior"),
              "grasp_semantics": logic.GetOutputPort("grasp_semantics"),
-             "ranked_grasps": scoring.GetOutputPort("ranked_grasps"),
+             "scored_grasps": scoring.GetOutputPort("ranked_grasps"),
+             "ranked_grasps": ranked,
              "plan_status": planner.GetOutputPort("plan_status"),
              "collisions": supervisor.GetOutputPort("collisions"),
+             "no_hold": supervisor.GetOutputPort("no_hold"),
              "plan_request": supervisor.GetOutputPort("plan_request"),
              "outcome": supervisor.GetOutputPort("outcome")}
     return Pipeline(station=station, perception=perception, target=target, prior=prior,
-                    logic=logic, scoring=scoring, planner=planner, supervisor=supervisor,
+                    logic=logic, scoring=scoring, feasibility=feasibility, planner=planner,
+                    supervisor=supervisor,
                     task=task, config=config, ports=ports)

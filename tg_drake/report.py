@@ -68,7 +68,11 @@ def evaluate_stages(pipeline, context, timings: dict, *, rgb: bool = False) -> S
             return stages
         stages.prior = timed("kernel_prior", pipeline.ports["category_prior"])
         stages.semantics = timed("logic", pipeline.ports["grasp_semantics"])
-        stages.ranked = timed("dgi_scoring", pipeline.ports["ranked_grasps"])
+        if "scored_grasps" in pipeline.ports:
+            timed("dgi_scoring", pipeline.ports["scored_grasps"])
+            stages.ranked = timed("feasibility", pipeline.ports["ranked_grasps"])
+        else:
+            stages.ranked = timed("dgi_scoring", pipeline.ports["ranked_grasps"])
     except TgDrakeError:
         pass
     return stages
@@ -121,6 +125,8 @@ def result_of(*, scenario, scenario_path: str, stages: Stages, outcome, plan_sta
             result["grasp"] = {**_xyz_rpy(plan_status.X_WG), "part": plan_status.part,
                                "p_part": float(ranked.p_part[i]) if known else None,
                                "p_local": float(ranked.p_local[i]) if known else None,
+                               "p_hold": (float(ranked.p_hold[i]) if known
+                                          and ranked.p_hold is not None else None),
                                "score": float(ranked.score[i]) if known else None}
     result["outcome"] = outcome.as_dict()
     if stages.warnings:
@@ -268,7 +274,8 @@ def _grasp_title(result: dict) -> str:
     if g["score"] is None:
         return f"grasp on {g['part']}\noutcome: {result['outcome']['status']}"
     return (f"grasp on {g['part']}: score {g['score']:.2f} = P(part|task) {g['p_part']:.2f} × "
-            f"P(grasp|shape) {g['p_local']:.2f}\noutcome: {result['outcome']['status']}")
+            f"P(grasp|shape) {g['p_local']:.2f}{_hold_text(g)}\n"
+            f"outcome: {result['outcome']['status']}")
 
 
 def summary(result: dict) -> str:
@@ -287,7 +294,8 @@ def summary(result: dict) -> str:
     if "grasp" in result and result["grasp"]["score"] is not None:
         g = result["grasp"]
         lines.append(f"grasp      part {g['part']}, xyz {g['xyz']}, score {g['score']:.3f} "
-                     f"(P(part|task) {g['p_part']:.2f} × P(grasp|shape) {g['p_local']:.2f})")
+                     f"(P(part|task) {g['p_part']:.2f} × P(grasp|shape) {g['p_local']:.2f}"
+                     f"{_hold_text(g)})")
     status = o["status"] + (f" ({o['reason']})" if o["reason"] else "")
     lines.append(f"outcome    {status}: {o['detail']}")
     if o["unreachable_parts"]:
@@ -300,3 +308,7 @@ def summary(result: dict) -> str:
     for w in result.get("warnings", []):
         lines.append(f"warning    {w}")
     return "\n".join(lines)
+
+
+def _hold_text(g: dict) -> str:
+    return f" × P(hold) {g['p_hold']:.2f}" if g.get("p_hold") is not None else ""

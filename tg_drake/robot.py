@@ -83,6 +83,7 @@ WSG_GRASP_POINT_G.flags.writeable = False
 WSG_STROKE = 0.055  # [m] each finger travels 0 … 0.055 m from the centre.
 WSG_MAX_OPENING = 2 * WSG_STROKE  # [m] 0.110: the pads' inner faces fully open.
 WSG_FORCE_LIMIT = 80.0  # [N] per finger: the drive's limit.
+WSG_PAD_FRICTION = 1.0  # Coulomb μ (static and dynamic) of the finger pads' contact material.
 WSG_FINGER_VELOCITY = 0.42  # [m/s] finger speed (the data sheet: up to 420 mm/s).
 WSG_BODY = "body"  # the link whose frame is G
 WSG_FINGERS = ("left_finger", "right_finger")  # finger links, closing from −x_G and +x_G

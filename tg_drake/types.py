@@ -182,3 +182,10 @@ class GraspCandidates:
     p_local: np.ndarray  # (M,) the SVM's P(grasp | local shape).
     score: np.ndarray  # (M,) combined score.
     target: int = 0  # index of the object in the scene description.
+    p_hold: np.ndarray | None = None  # (M,) GraspFeasibility's P(hold | pose); None: not assessed
+    # (scoring's output), taken as 1. Its score is then P(part | task) · P(local) · P(hold).
+    feasibility_reasons: tuple = ()  # (M,) why a pose is infeasible ("" if it is not); () when
+    # not assessed.
+    source: np.ndarray | None = None  # (M,) the scored hypothesis each pose was made from (the
+    # approach variants of one hypothesis share it); None: each row is its own.
+    unholdable_parts: tuple = ()  # parts that have candidates, none of which would hold

@@ -32,6 +32,7 @@ from tg_drake.robot import (
     WSG_FINGERS,
     WSG_FORCE_LIMIT,
     WSG_PAD_CENTRE_Y,
+    WSG_PAD_FRICTION,
     WSG_PAD_SIZE,
     WSG_STROKE,
 )
@@ -65,7 +66,7 @@ IIWA_LINKS = {
 IIWA_COLOR = {"iiwa_link_0": "0.4 0.4 0.4 1", "iiwa_link_7": "0.4 0.4 0.4 1"}
 IIWA_ORANGE = "1.0 0.42 0.04 1"
 
-PAD_HYDRO = dict(modulus=1e6, resolution=0.005, dissipation=3.0, mu=1.0)
+PAD_HYDRO = dict(modulus=1e6, resolution=0.005, dissipation=3.0, mu=WSG_PAD_FRICTION)
 
 # The table's facts and model are tg_drake.table's (the station sizes it from the scenario).
 

@@ -148,7 +148,7 @@ def test_the_resolved_scenario_round_trips_through_yaml(tmp_path):
     ("pipeline:\n  scoring: !OnePart {part: lid}\n", "pipeline.scoring.part",
      "unknown part 'lid'; allowed: top"),
     ("pipeline:\n  category_theory: general\n", "pipeline.category_theory",
-     "unknown field 'category_theory'; allowed: perception, prior, logic, scoring, planner"),
+     "unknown field 'category_theory'; allowed: perception, prior, logic, scoring, feasibility"),
 ])
 def test_pipeline_mistakes_name_the_field(tmp_path, text, field, message):
     with pytest.raises(ScenarioError) as e:

@@ -187,6 +187,29 @@ def test_the_first_informative_failure_stays_in_the_detail():
     assert "pre-grasp pose unreachable (bottom)" in o.detail
 
 
+def test_a_part_that_would_not_hold_is_told_apart_from_an_unreachable_one():
+    """The feasibility stage found no holding grasp on the bottom: when the plan fails with no
+    part blamed for reach, the bottom is no_hold evidence (not collision), the planner leaves it
+    out, and a run that ends there fails as would_not_hold."""
+    import dataclasses
+
+    unholdable = dataclasses.replace(GRASPS, unholdable_parts=("bottom",))
+    f = Fixed(grasps=unholdable)
+    f.advance(0.001)
+    f.plan(failed(1, None, reason="no candidate grasps left to try"))
+    f.advance(0.011)
+    no_hold = f.supervisor.get_no_hold_output_port().Eval(f.context)
+    assert (no_hold, f.collisions) == (("bottom",), ())
+    f.meaning(semantics(part={"bottom": 0.0, "top": 1.0}))
+    f.advance(0.021)
+    assert f.request == PlanRequest(attempt=2, exclude_parts=("bottom",))
+    f.plan(failed(2, None, reason="no candidate grasps left to try"))
+    f.advance(0.031)
+    o = f.outcome
+    assert (o.status, o.reason, o.unreachable_parts) == ("failed", "would_not_hold", ())
+    assert "no grasp on bottom would hold" in o.detail
+
+
 def test_no_plan_within_the_planning_timeout_fails_as_timeout():
     f = Fixed()
     f.advance(0.49)

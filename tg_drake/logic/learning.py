@@ -200,6 +200,7 @@ def scene_evidence(*, parts: Iterable[str], pose: str, containment: str | None,
         ev += [(Term("cat", o, Term(c)), c == category) for c in CATEGORIES]
     ev.append((Term("handle_pair", o), handles == 2))
     ev += [(Term("collision", Term(p)), False) for p in PART_LABELS]
+    ev += [(Term("no_hold", Term(p)), False) for p in PART_LABELS]
     return ev
 
 

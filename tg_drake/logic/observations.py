@@ -2,8 +2,8 @@
 
 `Observations` holds what perception, the kernel prior, the user and the planner say about the
 object under query: probabilistic parts, the pose likelihood, containment, the category prior (an
-annotated disjunction, or uniform), the given task or a task prior, collision(Part) evidence, the
-handle count, and whether the object's inside was seen through a wide opening (`interior_seen`,
+annotated disjunction, or uniform), the given task or a task prior, collision(Part) evidence
+(unreachable parts), no_hold(Part) evidence (parts on which no grasp would hold), the handle count, and whether the object's inside was seen through a wide opening (`interior_seen`,
 ours: the paper's parts cannot tell a glass from a can of the same shape; an open top can).
 It is validated on construction; bad input raises `RuleError` naming the field and the allowed
 values.
@@ -63,6 +63,8 @@ class Observations:
     task_prior: dict[str, float] | None = None
     # TASKS entry → probability when the task is inferred (sum ≤ 1, > 0); None: uniform 1/7.
     collisions: tuple[str, ...] = ()  # parts the gripper cannot reach: collision(Part) evidence.
+    no_hold: tuple[str, ...] = ()  # parts on which no grasp would hold (the feasibility stage):
+    # no_hold(Part) evidence (ours, beyond the paper).
     handles: int = 1  # handles seen when the handle part is there: 1, or 2 (a pot's pair).
     interior_seen: float = 0.0  # probability that the object's inside was seen through a wide
     # opening (0: not seen, or it could not be: upside down, facing away). Beyond the paper.
@@ -101,6 +103,12 @@ class Observations:
                 raise unknown_name("part", name, PART_LABELS, error=RuleError, file=self.source,
                                    field="collisions")
         self.collisions = tuple(dict.fromkeys(collisions))
+        no_hold = (self.no_hold,) if isinstance(self.no_hold, str) else self.no_hold
+        for name in no_hold:
+            if name not in PART_LABELS:
+                raise unknown_name("part", name, PART_LABELS, error=RuleError, file=self.source,
+                                   field="no_hold")
+        self.no_hold = tuple(dict.fromkeys(no_hold))
         if self.handles not in (1, 2):
             raise RuleError(f"handles must be 1 or 2, got {self.handles!r}", file=self.source,
                             field="handles")
@@ -123,6 +131,7 @@ class Observations:
             stick_breaking(self.category_vector()),
             stick_breaking(self.task_vector()),
             np.array([float(p in self.collisions) for p in PART_LABELS]),
+            np.array([float(p in self.no_hold) for p in PART_LABELS]),
             np.array([float(self.handles == 2)]),
             np.array([self.interior_seen]),
         ])
@@ -152,7 +161,7 @@ class Observations:
         if not isinstance(data, dict):
             raise RuleError("an observations file holds a mapping of fields", file=source)
         allowed = ("parts", "pose", "containment", "category_prior", "task", "task_prior",
-                   "collisions", "handles", "interior_seen")
+                   "collisions", "no_hold", "handles", "interior_seen")
         for key in data:
             if key not in allowed:
                 raise unknown_name("field", key, allowed, error=RuleError, file=source,
@@ -176,6 +185,9 @@ class Observations:
         collisions = data.get("collisions") or ()
         if not isinstance(collisions, list | tuple | str):
             raise RuleError("expected a list of part names", file=source, field="collisions")
+        no_hold = data.get("no_hold") or ()
+        if not isinstance(no_hold, list | tuple | str):
+            raise RuleError("expected a list of part names", file=source, field="no_hold")
         handles = data.get("handles", 1)
         if isinstance(handles, bool) or not isinstance(handles, int):
             raise RuleError(f"handles must be 1 or 2, got {handles!r}", file=source,
@@ -187,7 +199,9 @@ class Observations:
                    category_prior=data.get("category_prior"), task=task,
                    task_prior=data.get("task_prior"),
                    collisions=tuple(collisions) if not isinstance(collisions, str)
-                   else (collisions,), handles=handles,
+                   else (collisions,),
+                   no_hold=tuple(no_hold) if not isinstance(no_hold, str) else (no_hold,),
+                   handles=handles,
                    interior_seen=data.get("interior_seen", 0.0), source=source)
 
     @classmethod
@@ -207,10 +221,11 @@ class Observations:
     @classmethod
     def from_object(cls, obj: ObjectDescription, *,
                     prior: CategoryDistribution | None = None, task: str | None = None,
-                    collisions: tuple[str, ...] = (), prior_floor: float = 0.0
-                    ) -> Observations:
+                    collisions: tuple[str, ...] = (), prior_floor: float = 0.0,
+                    no_hold: tuple[str, ...] = ()) -> Observations:
         """From perception's description of one object, the kernel prior (None: uniform), the
-        task ("" or None: infer it) and the parts the planner could not reach. `prior_floor`
+        task ("" or None: infer it), the parts the planner could not reach and those on which
+        no grasp would hold (`no_hold`). `prior_floor`
         mixes the prior with the uniform one: (1 − floor)·p + floor/11."""
         category_prior = None
         if prior is not None:
@@ -227,7 +242,8 @@ class Observations:
         return cls(parts=dict(obj.part_probabilities), pose=dict(obj.pose_likelihood),
                    containment=None if obj.containment is None else {obj.containment: 1.0},
                    category_prior=category_prior, task=task or None,
-                   collisions=tuple(collisions), handles=count_handles(obj),
+                   collisions=tuple(collisions), no_hold=tuple(no_hold),
+                   handles=count_handles(obj),
                    interior_seen=float(getattr(obj, "interior_seen", 0.0)))
 
 
@@ -317,6 +333,7 @@ SCHEMA_PARAMETERS: tuple[tuple[str, str], ...] = (
     + tuple(("prior", c) for c in CATEGORIES)
     + tuple(("task", t) for t in TASKS)
     + tuple(("collision", p) for p in PART_LABELS)
+    + tuple(("no_hold", p) for p in PART_LABELS)
     + (("handles", "pair"),)
     + (("interior", "seen"),)
 )
@@ -350,6 +367,10 @@ def observation_schema() -> tuple[list[Term], dict[Term, int]]:
         fact = Term("collision", Term(part))
         clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
         rows[fact] = index[("collision", part)]
+    for part in PART_LABELS:
+        fact = Term("no_hold", Term(part))
+        clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
+        rows[fact] = index[("no_hold", part)]
     fact = Term("handle_pair", o)
     clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
     rows[fact] = index[("handles", "pair")]
@@ -383,6 +404,8 @@ def observation_clauses(obs: Observations) -> list[Term]:
             clauses.append(AnnotatedDisjunction(kept, body if body is not None else Term("true")))
     for part in obs.collisions:
         clauses.append(Term("collision", Term(part)))
+    for part in obs.no_hold:
+        clauses.append(Term("no_hold", Term(part)))
     if obs.handles == 2:
         clauses.append(Term("handle_pair", o))
     fact(Term("interior_seen", o), obs.interior_seen)
@@ -407,7 +430,8 @@ def _head(clause: Term) -> Term:
 def _schema_heads() -> list[Term]:
     o = _o()
     heads = [Term("part", Term(PART_LABELS[0]), o), Term("collision", Term(PART_LABELS[0])),
-             Term("handle_pair", o), Term("interior_seen", o)]
+             Term("no_hold", Term(PART_LABELS[0])), Term("handle_pair", o),
+             Term("interior_seen", o)]
     for _, group_heads, _ in _ad_groups():
         heads.extend(group_heads)
     return heads

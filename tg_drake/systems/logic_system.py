@@ -23,6 +23,7 @@ class LogicQuerySystem(LeafSystem):
         - category_prior
         - task
         - collisions
+        - no_hold
         output_ports:
         - grasp_semantics
 
@@ -32,7 +33,8 @@ class LogicQuerySystem(LeafSystem):
     disjunction when `config.use_prior`, else a uniform prior is used and the port may be left
     unconnected. ``task`` (str): a TASKS name, or "" to infer the task; unconnected means "".
     ``collisions`` (tuple of part names): collision(Part) evidence from the planner, the parts it
-    could not reach; unconnected or () means none.
+    could not reach; unconnected or () means none. ``no_hold`` (tuple of part names): no_hold(Part)
+    evidence, the parts on which the feasibility stage found no grasp that would hold; likewise.
 
     ``grasp_semantics`` (`GraspSemantics`): the normalised category, task and part distributions
     with explanations. A part distribution of all zeros means the theory rules every grasp out.
@@ -51,7 +53,8 @@ class LogicQuerySystem(LeafSystem):
         self._task_port = self.DeclareAbstractInputPort("task", AbstractValue.Make(""))
         self._collisions_port = self.DeclareAbstractInputPort(
             "collisions", AbstractValue.Make(()))
-        inputs = [self._scene_port, self._task_port, self._collisions_port]
+        self._no_hold_port = self.DeclareAbstractInputPort("no_hold", AbstractValue.Make(()))
+        inputs = [self._scene_port, self._task_port, self._collisions_port, self._no_hold_port]
         if self._config.use_prior:
             inputs.append(self._prior_port)
         self._semantics_port = self.DeclareAbstractOutputPort(
@@ -76,6 +79,9 @@ class LogicQuerySystem(LeafSystem):
 
     def get_collisions_input_port(self):
         return self._collisions_port
+
+    def get_no_hold_input_port(self):
+        return self._no_hold_port
 
     def get_grasp_semantics_output_port(self):
         return self._semantics_port
@@ -103,8 +109,13 @@ class LogicQuerySystem(LeafSystem):
         if isinstance(collisions, str) or not isinstance(collisions, tuple | list):
             raise RuleError(f"collisions must be a tuple of part names, got {collisions!r}",
                             field="collisions")
+        no_hold = (self._no_hold_port.Eval(context)
+                   if self._no_hold_port.HasValue(context) else ())
+        if isinstance(no_hold, str) or not isinstance(no_hold, tuple | list):
+            raise RuleError(f"no_hold must be a tuple of part names, got {no_hold!r}",
+                            field="no_hold")
         obs = Observations.from_object(scene.objects[target], prior=prior, task=task,
-                                       collisions=tuple(collisions),
+                                       collisions=tuple(collisions), no_hold=tuple(no_hold),
                                        prior_floor=self._config.prior_floor)
         answer = self._engine.query(obs, explain=self._config.explain)
         output.set_value(answer.to_semantics(target=target))

@@ -58,6 +58,7 @@ class Reason(enum.StrEnum):
 
     none = ""
     unreachable = "unreachable"
+    would_not_hold = "would_not_hold"  # reachable, but no grasp on the parts left would hold
     perception = "perception"
     logic = "logic"
     slipped = "slipped"
@@ -147,6 +148,7 @@ class _Memory:
     phase: Phase = Phase.gate
     attempt: int = 0  # the last plan attempt requested
     collisions: tuple = ()  # parts given to the logic as collision(Part) evidence
+    no_hold: tuple = ()  # parts given to the logic as no_hold(Part) evidence
     requeries: int = 0
     failures: tuple = ()  # (part or None, reason) of every failed attempt, in order
     status: PlanStatus | None = None  # the planner's answer with the plan being executed
@@ -176,6 +178,7 @@ class Supervisor(LeafSystem):
         - contact_results
         output_ports:
         - collisions
+        - no_hold
         - plan_request
         - outcome
 
@@ -189,7 +192,9 @@ class Supervisor(LeafSystem):
     check (`TgDrakeError`) ends the run as failed with that stage's reason.
 
     Outputs depend on the state only: ``collisions`` (tuple of part names, for the logic's
-    ``collisions`` input), ``plan_request`` (`PlanRequest`: the attempt to plan and the parts to
+    ``collisions`` input), ``no_hold`` (the parts on which the feasibility stage found no grasp
+    that would hold, `GraspCandidates.unholdable_parts`, for the logic's ``no_hold`` input),
+    ``plan_request`` (`PlanRequest`: the attempt to plan and the parts to
     leave out, for the planner) and ``outcome`` (`Outcome`; `Outcome.final` once decided).
     """
 
@@ -222,6 +227,9 @@ class Supervisor(LeafSystem):
         on_state = {self.abstract_state_ticket(self._memory)}
         self._collisions_port = self.DeclareAbstractOutputPort(
             "collisions", lambda: AbstractValue.Make(()), self._calc_collisions,
+            prerequisites_of_calc=on_state)
+        self._no_hold_port = self.DeclareAbstractOutputPort(
+            "no_hold", lambda: AbstractValue.Make(()), self._calc_no_hold,
             prerequisites_of_calc=on_state)
         self._request_port = self.DeclareAbstractOutputPort(
             "plan_request", lambda: AbstractValue.Make(PlanRequest()), self._calc_request,
@@ -258,6 +266,9 @@ class Supervisor(LeafSystem):
 
     def get_collisions_output_port(self):
         return self._collisions_port
+
+    def get_no_hold_output_port(self):
+        return self._no_hold_port
 
     def get_plan_request_output_port(self):
         return self._request_port
@@ -306,6 +317,9 @@ class Supervisor(LeafSystem):
         if memory.collisions:
             reason = Reason.unreachable
             told = f", told {', '.join(memory.collisions)} cannot be reached"
+        if memory.no_hold:
+            reason = Reason.unreachable if memory.collisions else Reason.would_not_hold
+            told += f", told no grasp on {', '.join(memory.no_hold)} would hold"
         semantics: GraspSemantics = self._semantics_port.Eval(context)
         task = semantics.given_task or "inferred"
         if not semantics.part or max(semantics.part.values()) <= 0:
@@ -318,6 +332,9 @@ class Supervisor(LeafSystem):
                                 f"{p:.3f} < {p_min} (task {task}{told})")
         grasps: GraspCandidates = self._grasps_port.Eval(context)
         if len(grasps.score) == 0 or not np.any(np.asarray(grasps.score) > 0):
+            if grasps.unholdable_parts:
+                reason = Reason.would_not_hold
+                told += f"; no grasp on {', '.join(grasps.unholdable_parts)} would hold"
             return self._finish(memory, Status.failed, reason,
                                 f"no pre-grasp hypothesis with a non-zero score{told}")
         return dataclasses.replace(memory, phase=Phase.planning, attempt=memory.attempt + 1)
@@ -330,7 +347,7 @@ class Supervisor(LeafSystem):
             return dataclasses.replace(memory, phase=Phase.executing, status=status,
                                        X_WO_picked=poses[self._model.object_body])
         if status.attempt >= memory.attempt and status.status is PlanState.failed:
-            return self._after_failure(memory, status)
+            return self._after_failure(memory, status, self._grasps_port.Eval(context))
         deadline = self._config.planning_start + self._config.planning_timeout
         if context.get_time() >= deadline:
             return self._finish(memory, Status.failed, Reason.timeout,
@@ -338,20 +355,29 @@ class Supervisor(LeafSystem):
                                 f"{self._config.planning_timeout} s (attempt {memory.attempt})")
         return memory
 
-    def _after_failure(self, memory: _Memory, status: PlanStatus) -> _Memory:
+    def _after_failure(self, memory: _Memory, status: PlanStatus,
+                       grasps: GraspCandidates) -> _Memory:
         failures = memory.failures + ((status.failed_part, status.reason),)
         why = _why(failures)
-        new = tuple(p for p in status.unreachable_parts if p not in memory.collisions)
-        if not new:  # nothing new to tell the logic
-            return self._finish(memory, Status.failed, Reason.unreachable, why,
-                                failures=failures)
-        collisions = memory.collisions + new
+        told = memory.collisions + memory.no_hold
+        new = tuple(p for p in status.unreachable_parts if p not in told)
+        # Parts the feasibility stage found no holding grasp on: not unreachable, told apart.
+        held = tuple(p for p in grasps.unholdable_parts if p not in told and p not in new)
+        # No part blamed for reach, and some would not hold: the run fails for holding.
+        holding = not status.unreachable_parts and bool(memory.no_hold + held)
+        reason = Reason.would_not_hold if holding else Reason.unreachable
+        if holding:
+            why = f"no grasp on {', '.join(memory.no_hold + held)} would hold; {why}"
+        if not new and not held:  # nothing new to tell the logic
+            return self._finish(memory, Status.failed, reason, why, failures=failures)
+        collisions, no_hold = memory.collisions + new, memory.no_hold + held
         if memory.requeries >= self._config.max_requeries:
-            return self._finish(memory, Status.failed, Reason.unreachable,
+            return self._finish(memory, Status.failed, reason,
                                 f"gave up after {memory.requeries} re-queries; {why}",
-                                failures=failures, collisions=collisions)
+                                failures=failures, collisions=collisions, no_hold=no_hold)
         return dataclasses.replace(memory, phase=Phase.gate, failures=failures,
-                                   collisions=collisions, requeries=memory.requeries + 1)
+                                   collisions=collisions, no_hold=no_hold,
+                                   requeries=memory.requeries + 1)
 
     def _monitor(self, context, memory: _Memory) -> _Memory:
         plan, t_plan = memory.status.plan, memory.status.t_plan
@@ -399,9 +425,13 @@ class Supervisor(LeafSystem):
     def _calc_collisions(self, context, output):
         output.set_value(self._memory_of(context).collisions)
 
+    def _calc_no_hold(self, context, output):
+        output.set_value(self._memory_of(context).no_hold)
+
     def _calc_request(self, context, output):
         memory = self._memory_of(context)
-        output.set_value(PlanRequest(attempt=memory.attempt, exclude_parts=memory.collisions))
+        output.set_value(PlanRequest(attempt=memory.attempt,
+                                     exclude_parts=memory.collisions + memory.no_hold))
 
     def _calc_outcome(self, context, output):
         memory = self._memory_of(context)

@@ -1,0 +1,547 @@
+"""Grasp feasibility: would the gripper get there clear of everything, and would the grasp hold?
+
+One stage, one model, on the pose that will be executed (the grasp frame G of tg_drake.robot:
+fingers close along ±x_G, approach along +y_G, z_G across the pads):
+
+(a) collision — the WSG's boxes (the housing and the two finger pads, `tg_drake.robot`) against
+    the perceived points and the table plane: the open gripper swept along its approach from the
+    pre-grasp to the grasp, and the pads closing from open onto the target. Signed distances of
+    points to boxes (`box_signed_distance`). The other objects' points and the table make a pose
+    infeasible; the target's cut of the gripper (it pushes the object as it comes: in physics
+    episodes such grasps held as often as not) is a feature of the hold model. At the release
+    the pads open around the object in the same relative pose, the object a little above the
+    table: the grasp's open-pad and table checks stand for it.
+(b) hold margin — contact mechanics: the points between the pads that the closing pads reach
+    first are the contact patches (area, extent, centre); the pads' Coulomb friction μ
+    (tg_drake.robot.WSG_PAD_FRICTION and the object's), the normal force (the grip, capped by the
+    WSG's force limit), the object's mass (its perceived convex-hull volume × a density per
+    category — the training objects' mass / hull volume, shipped with the hold model — weighted by
+    the logic's category distribution) and the lever of its weight about the closing axis give the wrench the patches must carry under the lift and carry
+    accelerations and the wrench they can carry: a translational, a torsional and a combined
+    margin (elliptic limit surface: margin < 1 slips).
+(c) P(hold | features) — a logistic regression on the margins and patch features, fitted on
+    physics episodes of training objects (tools/fit_hold_model.py; tg_drake/data/hold_model.json).
+
+Arrays in, arrays out: no Drake.
+"""
+
+
+import functools
+import json
+from dataclasses import dataclass, field
+from importlib.resources import files
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import ConvexHull, QhullError
+
+from tg_drake.errors import ModelError, ScenarioError
+from tg_drake.robot import (
+    WSG_BODY_CENTRE_G,
+    WSG_BODY_SIZE,
+    WSG_FORCE_LIMIT,
+    WSG_GRASP_POINT_G,
+    WSG_MAX_OPENING,
+    WSG_PAD_FRICTION,
+    WSG_PAD_SIZE,
+    wsg_pad_boxes,
+)
+from tg_drake.types import CATEGORIES, PART_LABELS, GraspCandidates, SceneDescription
+
+GRAVITY = 9.81  # [m/s²]
+GRASP_DEPTH = float(WSG_GRASP_POINT_G[1])  # [m] the grasp point lies this far along +y_G.
+HOLD_MODEL = "hold_model.json"  # in tg_drake/data: the shipped fit (tools/fit_hold_model.py)
+
+
+@dataclass
+class FeasibilityConfig:
+    """The physics and the fitted model of grasp feasibility (`PipelineConfig.feasibility`)."""
+
+    opening: float = WSG_MAX_OPENING  # [m] the WSG's opening while it moves (its full stroke).
+    point_tolerance: float = 0.002  # [m] a point cuts a box when this deep in it (perception's
+    # 1 mm noise per axis, twice).
+    min_points: int = 3  # a box's cut is its min_points-th deepest point's (stray points do not
+    # count).
+    table_clearance: float = 0.0  # [m] the gripper's boxes stay this far above the table top.
+    pad_friction: float = WSG_PAD_FRICTION  # Coulomb μ of the WSG's pads (models/wsg_50).
+    object_friction: float = 1.0  # Coulomb μ assumed for the object (the shipped library's
+    # models/objects/*.sdf); the contact's μ is 2 μ_pad μ_object / (μ_pad + μ_object) (Drake's
+    # rule).
+    grip_force: float = 60.0  # [N] each pad's normal force on the object, capped by the WSG's
+    # force limit (robot.WSG_FORCE_LIMIT, 80 N): the grasp episodes' set point.
+    contact_depth: float = 0.003  # [m] points within this of a pad's first contact along x_G
+    # form its patch (perception's voxel is 4 mm; the pads' hydroelastic layer yields ~1 mm).
+    patch_cell: float = 0.004  # [m] cells of a patch's area (perception's voxel).
+    lift_acceleration: float = 2.0  # [m/s²] upwards, at the lift (a design load).
+    carry_acceleration: float = 3.0  # [m/s²] horizontal, any direction, while carried.
+    default_density: float = 500.0  # [kg/m³] of convex-hull volume, when no category
+    # distribution is given (the hold model's per-category densities otherwise).
+    min_p_hold: float = 0.5  # a candidate more likely to slip than to hold (P(hold) below this)
+    # gets score 0, "would not hold".
+    model: str = ""  # a hold-model JSON file (tools/fit_hold_model.py); "" = the shipped one.
+    approach_tilts: list[float] = field(default_factory=lambda: [10.0, 20.0, 35.0])  # [deg] a
+    # side grasp (approach within 30° of horizontal) is also offered tilted downwards about its
+    # closing axis through its grasp point by these angles: the fingers still close across the
+    # same part, and the wrist rises clear of the table.
+    top_tilts: list[float] = field(default_factory=lambda: [15.0, 30.0])  # [deg] a steep grasp is
+    # also offered with its wrist tilted back towards the robot about the closing axis.
+    pad_table_clearance: float = 0.004  # [m] a pose whose open pads reach under the table top is
+    # moved back along its approach until they clear it by this much (`clear_of_table`).
+
+    def validate(self, where: str = "feasibility") -> None:
+        for name in ("opening", "grip_force", "contact_depth", "patch_cell", "pad_friction",
+                     "object_friction", "default_density"):
+            if not getattr(self, name) > 0:
+                raise ScenarioError(f"{name} must be > 0, got {getattr(self, name)}",
+                                    field=f"{where}.{name}")
+        if not 0.0 <= self.min_p_hold <= 1.0:
+            raise ScenarioError(f"min_p_hold must be in [0, 1], got {self.min_p_hold}",
+                                field=f"{where}.min_p_hold")
+        if self.model and not Path(self.model).is_file():
+            raise ScenarioError(f"no such hold model file {self.model!r}",
+                                field=f"{where}.model")
+
+    @property
+    def friction(self) -> float:
+        """The pad–object contact's μ (Drake's combination of the two materials' μ)."""
+        a, b = self.pad_friction, self.object_friction
+        return 2 * a * b / (a + b)
+
+
+# --- (a) collision ------------------------------------------------------------------------------
+
+
+def box_signed_distance(p_B: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """(N,) signed distances [m] of points p_B (N, 3), in the frame of an axis-aligned box centred
+    at the origin with half sizes `half`, to the box's surface: negative inside."""
+    q = np.abs(p_B) - np.asarray(half, float)
+    outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
+    inside = np.minimum(q.max(axis=1), 0.0)
+    return outside + inside
+
+
+def gripper_boxes(opening: float, approach: float = 0.0) -> list[tuple[str, np.ndarray,
+                                                                     np.ndarray]]:
+    """The WSG's boxes in G (name, centre, half size) with its pads `opening` [m] apart, each
+    swept `approach` [m] back along −y_G (the volume the box passes through on the approach)."""
+    out = [("housing", np.array(WSG_BODY_CENTRE_G, float), np.array(WSG_BODY_SIZE) / 2)]
+    for side, (c, size) in zip(("left pad", "right pad"), wsg_pad_boxes(opening), strict=True):
+        out.append((side, np.asarray(c, float), np.asarray(size, float) / 2))
+    if approach > 0:
+        out = [(n, c - [0.0, approach / 2, 0.0], h + [0.0, approach / 2, 0.0])
+               for n, c, h in out]
+    return out
+
+
+def _box_corners_W(X_WG: np.ndarray, centre, half) -> np.ndarray:
+    s = np.array(np.meshgrid(*[(-1.0, 1.0)] * 3)).reshape(3, -1).T
+    return (centre + s * half) @ X_WG[:3, :3].T + X_WG[:3, 3]
+
+
+def penetration(X_WG: np.ndarray, p_W: np.ndarray, boxes, k: int) -> dict[str, float]:
+    """Box name → how deep [m] the points p_W cut it: the k-th deepest point's depth (robust to
+    k − 1 stray points), 0 when fewer than k points are inside."""
+    out = {name: 0.0 for name, _, _ in boxes}
+    if len(p_W) < k:
+        return out
+    p_G = (np.asarray(p_W, float) - X_WG[:3, 3]) @ X_WG[:3, :3]
+    lo = np.min([c - h for _, c, h in boxes], axis=0)
+    hi = np.max([c + h for _, c, h in boxes], axis=0)
+    p_G = p_G[np.all((p_G >= lo) & (p_G <= hi), axis=1)]  # only points inside some box count
+    if len(p_G) < k:
+        return out
+    for name, c, h in boxes:
+        depth = -box_signed_distance(p_G - c, h)
+        out[name] = max(out[name], float(max(np.partition(depth, -k)[-k], 0.0)))
+    return out
+
+
+@dataclass(frozen=True)
+class Collision:
+    """How the gripper meets what it must not touch (the other objects, the table)."""
+
+    depth: float  # [m] the deepest cut of a box by another object's points (≥ 0)
+    box: str  # the box cut most ("" when none)
+    what: str  # "other object" | "table" | "" (free)
+    table_clearance: float  # [m] the lowest box corner above the table (negative: under it)
+
+    @property
+    def free(self) -> bool:
+        return not self.what
+
+
+def closing_sweep(opening: float, closed_width: float) -> list:
+    """The pads' boxes swept from `opening` [m] apart to `closed_width` [m] apart (G)."""
+    sweep = []
+    for (c_o, s), (c_c, _) in zip(wsg_pad_boxes(opening), wsg_pad_boxes(max(closed_width, 0.0)),
+                                  strict=True):
+        lo = np.minimum(c_o - s / 2, c_c - s / 2)
+        hi = np.maximum(c_o + s / 2, c_c + s / 2)
+        sweep.append(("closing pad", (lo + hi) / 2, (hi - lo) / 2))
+    return sweep
+
+
+def collision(X_WG: np.ndarray, *, others_p_W: np.ndarray, table_z: float, approach: float,
+              config: FeasibilityConfig, closed_width: float | None = None) -> Collision:
+    """The open gripper swept from `approach` [m] back along its approach to X_WG, and the pads
+    closing from open to `closed_width` [m] (the target's width between them; None: not
+    checked), against the other objects' points and the table plane at height `table_z`."""
+    boxes = gripper_boxes(config.opening, approach)
+    if closed_width is not None:
+        boxes = boxes + closing_sweep(config.opening, closed_width)
+    cut = penetration(X_WG, others_p_W, boxes, config.min_points)
+    name = max(cut, key=cut.get)
+    table = min(_box_corners_W(X_WG, c, h)[:, 2].min() for _, c, h in boxes) - table_z
+    if cut[name] > config.point_tolerance:
+        return Collision(cut[name], name, "other object", float(table))
+    if table < config.table_clearance:
+        return Collision(float(config.table_clearance - table), "", "table", float(table))
+    return Collision(0.0, "", "", float(table))
+
+
+# --- (b) hold margin ----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Hold:
+    """The contact mechanics of one grasp (all in SI units)."""
+
+    width: float  # [m] the target between the pads along x_G (0: nothing between them)
+    n_points: int  # perceived points between the pads
+    patch_area: float  # [m²] the smaller of the two pads' contact patches
+    patch_extent: float  # [m] the smaller patch's smaller extent across its face
+    torsion_radius: float  # [m] mean distance of the patches' cells from their centres
+    p_WC: np.ndarray  # (3,) the contact centre (between the patches' centres)
+    mass: float  # [kg] estimated
+    lever: float  # [m] of the weight about the closing axis through the contact centre
+    force_capacity: float  # [N] tangential force the two patches carry (2 μ N)
+    torque_capacity: float  # [N·m] torque about x_G they carry by friction
+    translational_margin: float  # capacity / the largest tangential load (inf: no load)
+    torsional_margin: float  # capacity / the largest torque about x_G
+    margin: float  # the combined (elliptic limit surface) margin: < 1 slips
+    pad_cut: float = 0.0  # [m] how deep the target's points cut the open pads' approach sweep
+    housing_cut: float = 0.0  # [m] … and the housing's: the gripper pushes the object there
+
+    def features(self) -> np.ndarray:
+        return hold_feature_vector(self)
+
+
+# The model's inputs: the combined margin carries the mass, the friction, the force and the lever
+# (the translational and torsional margins, the mass and the lever alone are reported, not fitted:
+# collinear with it, they let a small fit give margin the wrong sign).
+FEATURES = ("log_margin_shortfall", "log_patch_area_mm2", "patch_extent_mm", "width_fraction",
+            "pad_cut_mm", "housing_cut_mm")
+_MAX_LOG = 5.0  # log-margins clipped to ±5 (e⁵ ≈ 150: beyond that, more margin says nothing)
+
+
+def hold_feature_vector(h: Hold) -> np.ndarray:
+    def lg(x):
+        return float(np.clip(np.log(max(x, 1e-9)), -_MAX_LOG, _MAX_LOG))
+    # Margin beyond e (the loads tripled) says nothing more about slipping: log margin ≤ 1.
+    return np.array([min(lg(h.margin), 1.0), lg(h.patch_area * 1e6 + 1e-3), h.patch_extent * 1e3,
+                     h.width / WSG_MAX_OPENING, h.pad_cut * 1e3, h.housing_cut * 1e3])
+
+
+def mean_density(category: dict[str, float] | None, densities: dict[str, float],
+                 default: float) -> float:
+    """[kg/m³] the per-category densities (category → kg/m³ of convex-hull volume) weighted by a
+    category distribution (name → probability); `default` when none is given or known."""
+    if not category:
+        return default
+    w = np.array([max(float(category.get(c, 0.0)), 0.0) if c in densities else 0.0
+                  for c in CATEGORIES])
+    if w.sum() <= 0:
+        return default
+    rho = np.array([densities.get(c, 0.0) for c in CATEGORIES])
+    return float(w @ rho / w.sum())
+
+
+def hull_volume(p_W: np.ndarray) -> float:
+    """[m³] of the points' convex hull (0 for fewer than 4 points or a flat set)."""
+    if len(p_W) < 4:
+        return 0.0
+    try:
+        return float(ConvexHull(np.asarray(p_W, float)).volume)
+    except QhullError:
+        return 0.0
+
+
+def _patch(q: np.ndarray, cell: float) -> tuple[float, float, np.ndarray, float]:
+    """(area, smaller extent, centre (y, z), mean cell distance from the centre) of patch points
+    q (n, 2) in a pad's face coordinates."""
+    cells = np.unique(np.floor(q / cell).astype(int), axis=0)
+    centres = (cells + 0.5) * cell
+    centre = centres.mean(axis=0)
+    extent = float(np.min(np.ptp(q, axis=0))) if len(q) > 1 else 0.0
+    radius = float(np.linalg.norm(centres - centre, axis=1).mean())
+    # A single cell still turns about its own extent: at least a cell's mean radius (≈ 0.38 a).
+    return len(cells) * cell ** 2, extent, centre, max(radius, 0.38 * cell)
+
+
+def hold(X_WG: np.ndarray, *, target_p_W: np.ndarray, mass: float,
+         config: FeasibilityConfig, p_WCoM: np.ndarray | None = None,
+         approach: float = 0.0) -> Hold:
+    """The hold of grasp X_WG on the target's points (the completed cloud), an object of `mass`
+    [kg] with its centre of mass at p_WCoM (default: the points' centroid); the target's cut of
+    the open gripper swept `approach` [m] along its approach (the gripper pushes the object
+    there: whether it still holds is the fitted model's to say)."""
+    p_W = np.asarray(target_p_W, float)
+    com = p_W.mean(axis=0) if p_WCoM is None and len(p_W) else np.asarray(p_WCoM, float)
+    R, t = X_WG[:3, :3], X_WG[:3, 3]
+    p_G = (p_W - t) @ R
+    y0, y1 = WSG_GRASP_POINT_G[1] - WSG_PAD_SIZE[1] / 2, WSG_GRASP_POINT_G[1] + WSG_PAD_SIZE[1] / 2
+    between = p_G[(p_G[:, 1] >= y0) & (p_G[:, 1] <= y1)
+                  & (np.abs(p_G[:, 2]) <= WSG_PAD_SIZE[2] / 2)
+                  & (np.abs(p_G[:, 0]) <= config.opening / 2)]
+    N = min(config.grip_force, WSG_FORCE_LIMIT)
+    mu = config.friction
+    cut = penetration(X_WG, p_W, gripper_boxes(config.opening, approach), config.min_points)
+    cuts = dict(pad_cut=max(cut["left pad"], cut["right pad"]), housing_cut=cut["housing"])
+    if len(between) < 2:
+        p = t + R @ WSG_GRASP_POINT_G
+        return Hold(0.0, len(between), 0.0, 0.0, 0.0, p, mass, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                    **cuts)
+    x = between[:, 0]
+    lo, hi = x.min(), x.max()
+    left = between[x <= lo + config.contact_depth][:, 1:]
+    right = between[x >= hi - config.contact_depth][:, 1:]
+    (aL, eL, cL, rL), (aR, eR, cR, rR) = (_patch(q, config.patch_cell) for q in (left, right))
+    c_G = np.array([(lo + hi) / 2, *(cL + cR) / 2])
+    p_WC = t + R @ c_G
+    force_cap = 2 * mu * N
+    torque_cap = mu * N * (rL + rR)
+    # The loads: the patches accelerate the object by a against gravity: f = m (a − g).
+    dirs = np.linspace(0.0, 2 * np.pi, 8, endpoint=False)
+    accel = np.vstack([[0.0, 0.0, 0.0], [0.0, 0.0, config.lift_acceleration],
+                       config.carry_acceleration * np.column_stack(
+                           [np.cos(dirs), np.sin(dirs), np.zeros_like(dirs)])])
+    f_W = mass * (accel + [0.0, 0.0, GRAVITY])
+    r_W = com - p_WC
+    tau_W = np.cross(r_W, f_W)
+    x_G = R[:, 0]
+    f_t = np.linalg.norm(f_W - np.outer(f_W @ x_G, x_G), axis=1)  # across the pads' faces
+    tau_x = np.abs(tau_W @ x_G)
+    u = np.sqrt((f_t / force_cap) ** 2 + (tau_x / max(torque_cap, 1e-12)) ** 2)
+    lever = float(abs(x_G @ np.cross(r_W, [0.0, 0.0, 1.0])))
+    return Hold(width=float(hi - lo), n_points=len(between), patch_area=float(min(aL, aR)),
+                patch_extent=float(min(eL, eR)), torsion_radius=float((rL + rR) / 2), p_WC=p_WC,
+                mass=float(mass), lever=lever, force_capacity=force_cap,
+                torque_capacity=torque_cap,
+                translational_margin=float(force_cap / f_t.max()) if f_t.max() > 0 else np.inf,
+                torsional_margin=float(torque_cap / tau_x.max()) if tau_x.max() > 0 else np.inf,
+                margin=float(1.0 / u.max()) if u.max() > 0 else np.inf, **cuts)
+
+
+# --- (c) P(hold | features) ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class HoldModel:
+    """A fitted logistic regression: P(hold) = σ(w · (f − mean) / scale + b)."""
+
+    features: tuple[str, ...]
+    mean: np.ndarray
+    scale: np.ndarray
+    weights: np.ndarray
+    bias: float
+    meta: dict
+
+    @property
+    def densities(self) -> dict[str, float]:
+        """[kg/m³] per category: the training objects' median mass / convex-hull volume (the
+        volume perception can see: the importing prior's mass / enclosed volume is the walls'
+        material for an open container's closed-wall mesh, not comparable)."""
+        return dict(self.meta.get("hull_density_kg_m3", {}))
+
+    def predict_proba(self, F: np.ndarray) -> np.ndarray:
+        """(n,) P(hold) for features F (n, len(features))."""
+        z = ((np.atleast_2d(F) - self.mean) / self.scale) @ self.weights + self.bias
+        return 1.0 / (1.0 + np.exp(-z))
+
+    def as_dict(self) -> dict:
+        return {"features": list(self.features), "mean": self.mean.tolist(),
+                "scale": self.scale.tolist(), "weights": self.weights.tolist(),
+                "bias": self.bias, **self.meta}
+
+
+def load_hold_model(path: str | Path | None = None) -> HoldModel:
+    """The hold model of a JSON file (tools/fit_hold_model.py); None: the shipped one."""
+    src = Path(path) if path else files("tg_drake.data").joinpath(HOLD_MODEL)
+    try:
+        d = json.loads(src.read_text())
+        model = HoldModel(tuple(d["features"]), np.array(d["mean"], float),
+                          np.array(d["scale"], float), np.array(d["weights"], float),
+                          float(d["bias"]), {k: v for k, v in d.items() if k not in (
+                              "features", "mean", "scale", "weights", "bias")})
+    except (OSError, KeyError, ValueError, TypeError) as e:
+        raise ModelError(f"not a hold model: {e}", file=str(src)) from None
+    if model.features != FEATURES:
+        raise ModelError(f"hold model features {list(model.features)}; this code computes "
+                         f"{list(FEATURES)}: refit it (tools/fit_hold_model.py)", file=str(src))
+    return model
+
+
+@functools.cache
+def _shipped_model() -> HoldModel:
+    return load_hold_model()
+
+
+# --- the stage: every candidate -----------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Feasibility:
+    """Per candidate: P(hold), why it is infeasible ("" if it is not), and its mechanics."""
+
+    p_hold: np.ndarray  # (M,)
+    reasons: tuple[str, ...]  # (M,)
+    holds: tuple[Hold, ...]
+    collisions: tuple[Collision, ...]
+
+
+def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: np.ndarray,
+                      table_z: float, approach: float, category: dict[str, float] | None,
+                      config: FeasibilityConfig, model: HoldModel | None = None) -> Feasibility:
+    """Feasibility of every grasp pose X_WG (M, 4, 4) on the target: collision (a), then the hold
+    (b) and its probability (c). A pose that collides gets P(hold) 0 and the reason."""
+    model = model or (load_hold_model(config.model) if config.model else _shipped_model())
+    target_p_W = np.asarray(target_p_W, float).reshape(-1, 3)
+    others_p_W = np.asarray(others_p_W, float).reshape(-1, 3)
+    mass = hull_volume(target_p_W) * mean_density(category, model.densities,
+                                                  config.default_density)
+    p, reasons, holds, hits = [], [], [], []
+    for X in np.asarray(X_WG, float).reshape(-1, 4, 4):
+        h = hold(X, target_p_W=target_p_W, mass=mass, config=config, approach=approach)
+        c = collision(X, others_p_W=others_p_W, table_z=table_z, approach=approach,
+                      config=config, closed_width=h.width if h.n_points else None)
+        holds.append(h)
+        hits.append(c)
+        if not c.free:
+            reasons.append(f"collision: the {c.box} would cut another object by "
+                           f"{c.depth * 1000:.1f} mm" if c.what == "other object" else
+                           f"collision: the gripper would reach {-c.table_clearance * 1000:.1f} "
+                           "mm under the table top")
+            p.append(0.0)
+            continue
+        if h.n_points < 2:
+            reasons.append("nothing between the pads")
+            p.append(0.0)
+            continue
+        ph = float(model.predict_proba(h.features())[0])
+        p.append(ph)
+        reasons.append("" if ph >= config.min_p_hold else
+                       f"would not hold: P(hold) {ph:.2f} (margin {h.margin:.2f}, patch "
+                       f"{h.patch_area * 1e6:.0f} mm², lever {h.lever * 1000:.0f} mm, "
+                       f"mass {h.mass:.2f} kg)")
+    return Feasibility(np.array(p), tuple(reasons), tuple(holds), tuple(hits))
+
+
+# --- the poses that will be executed ------------------------------------------------------------
+
+# The open finger pads in G: the 8 outer corners of the pair [m].
+PAD_CORNERS_G = np.array([c + s * np.asarray(size) / 2 for c, size in wsg_pad_boxes()
+                          for s in np.array(np.meshgrid(*[(-1.0, 1.0)] * 3)).reshape(3, -1).T])
+
+
+def clear_of_table(X_WG: np.ndarray, table_z: float, clearance: float) -> np.ndarray | None:
+    """X_WG moved back along its approach until the open pads clear the table top by
+    `clearance` [m]. None if moving back cannot help (an approach that does not point down)."""
+    p_W = X_WG[:3, :3] @ PAD_CORNERS_G.T + X_WG[:3, 3:4]
+    deficit = table_z + clearance - p_W[2].min()
+    if deficit <= 0:
+        return X_WG
+    down = -X_WG[2, 1]  # how much the approach +y_G points down
+    if down < 0.2:
+        return None
+    X = X_WG.copy()
+    X[:3, 3] -= X_WG[:3, 1] * (deficit / down)
+    return X
+
+
+def _tilted(X_WG: np.ndarray, angle: float) -> np.ndarray:
+    """X_WG turned about its closing axis x_G through its grasp point by `angle` [rad]."""
+    c, s_ = np.cos(angle), np.sin(angle)
+    R = X_WG[:3, :3] @ np.array([[1, 0, 0], [0, c, -s_], [0, s_, c]])
+    X = np.eye(4)
+    X[:3, :3] = R
+    X[:3, 3] = X_WG[:3, 3] + GRASP_DEPTH * X_WG[:3, 1] - GRASP_DEPTH * R[:, 1]
+    return X
+
+
+def approach_variants(X_WG: np.ndarray, config: FeasibilityConfig, *, table_z: float = 0.0
+                      ) -> list[np.ndarray]:
+    """X_WG itself, then, for a side grasp (approach within 30° of horizontal), X_WG tilted
+    downwards about its closing axis through the grasp point by each of `config.approach_tilts`,
+    and for a steep grasp, tilted back towards the robot (at the world origin) by each of
+    `config.top_tilts`; each moved back along its approach when its open pads would reach under
+    the table (`clear_of_table`), and dropped when that cannot help."""
+    variants = [X_WG]
+    y = X_WG[:3, 1]
+    p_grasp = X_WG[:3, 3] + GRASP_DEPTH * y
+    if abs(y[2]) > np.sin(np.deg2rad(30.0)):
+        towards_robot = -p_grasp[:2] / max(np.linalg.norm(p_grasp[:2]), 1e-9)
+        for tilt in np.deg2rad(config.top_tilts):
+            # the sign whose body (−y_G) leans most towards the robot
+            lean, sign = max(((-_tilted(X_WG, s * tilt)[:2, 1] @ towards_robot, s)
+                              for s in (1.0, -1.0)), key=lambda v: v[0])
+            if lean > 1e-6:
+                variants.append(_tilted(X_WG, sign * tilt))
+    else:
+        for tilt in np.deg2rad(config.approach_tilts):
+            for sign in (1.0, -1.0):
+                X = _tilted(X_WG, sign * tilt)
+                if X[2, 1] < y[2]:  # the approach points further down
+                    variants.append(X)
+                    break
+    cleared = (clear_of_table(V, table_z, config.pad_table_clearance) for V in variants)
+    return [X for X in cleared if X is not None]
+
+
+# --- the stage on a scene -------------------------------------------------------------------
+
+
+def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
+                      category: dict[str, float] | None, approach: float,
+                      config: FeasibilityConfig, model: HoldModel | None = None
+                      ) -> GraspCandidates:
+    """The candidates as they will be executed: each hypothesis with its approach variants
+    (`approach_variants`), each pose with P(hold) and the score P(part | task) · P(grasp | local
+    shape) · P(hold) (0 with a reason where infeasible), best first. `category`: the logic's
+    category distribution (the mass's density prior); `approach` [m]: the planner's pre-grasp
+    distance (the approach swept for collisions)."""
+    m = len(candidates.score)
+    if m == 0 or not 0 <= candidates.target < len(scene.objects):
+        return GraspCandidates(np.zeros((0, 4, 4)), np.zeros(0, int), np.zeros(0), np.zeros(0),
+                               np.zeros(0), candidates.target, p_hold=np.zeros(0),
+                               source=np.zeros(0, int))
+    target = scene.objects[candidates.target]
+    others = [o.p_W for i, o in enumerate(scene.objects) if i != candidates.target]
+    others_p_W = np.concatenate(others) if others else np.zeros((0, 3))
+    table_z = float(scene.X_WT[2, 3])
+    poses, source = [], []
+    for i in range(m):
+        variants = approach_variants(np.asarray(candidates.X_WG[i], float), config,
+                                     table_z=table_z)
+        poses += variants
+        source += [i] * len(variants)
+    source = np.array(source, int)
+    X_WG = np.array(poses).reshape(-1, 4, 4)
+    f = grasp_feasibility(X_WG, target_p_W=target.p_W, others_p_W=others_p_W, table_z=table_z,
+                          approach=approach, category=category, config=config, model=model)
+    p_part = np.asarray(candidates.p_part, float)[source]
+    p_local = np.asarray(candidates.p_local, float)[source]
+    parts = np.asarray(candidates.parts, int)[source]
+    ok = np.array([not r for r in f.reasons], bool)
+    score = np.where(ok, p_part * p_local * f.p_hold, 0.0)
+    order = np.argsort(-score, kind="stable")
+    # Parts the logic and the shape allow, none of whose poses would hold (not for collisions).
+    viable = p_part * p_local > 0
+    unholdable = tuple(
+        PART_LABELS[k] for k in np.unique(parts[viable])
+        if not ok[viable & (parts == k)].any()
+        and any(f.reasons[j].startswith("would not hold")
+                for j in np.flatnonzero(viable & (parts == k))))
+    return GraspCandidates(X_WG[order], parts[order], p_part[order], p_local[order],
+                           score[order], candidates.target, p_hold=f.p_hold[order],
+                           feasibility_reasons=tuple(f.reasons[j] for j in order),
+                           source=source[order], unholdable_parts=unholdable)
