@@ -69,6 +69,8 @@ class PoseConfig:
     taper_ratio: float = 0.95  # top radius below this share of the base radius is a taper ...
     taper_body_ratio: float = 0.98  # ... narrowing already at mid-height (a can's rim does not)
     strong_taper_ratio: float = 0.9  # ... or narrowing this much at the top.
+    calibration: str = ""  # a pose likelihood file (tools/calibrate_pose.py writes one); "" =
+    # the shipped tg_drake/data/pose_likelihood.json
 
 
 @dataclass
