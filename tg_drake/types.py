@@ -98,6 +98,7 @@ class ObjectDescription:
     is_tool: bool = False  # True when perception classified the shape as a tool.
     name: str = ""  # ground-truth instance name when known (GroundTruthPerception), else "".
     interior_seen: float = 0.0  # probability that its inside was seen through a wide opening.
+    pose_cue: str = ""  # what decided the pose (perception.pose.PoseEstimate.cue), or "".
 
 
 @dataclass

@@ -121,3 +121,19 @@ def test_the_sensor_is_a_tagged_field_of_depth_perception(tmp_path):
 def test_bad_sensor_settings_are_clear_errors(tmp_path, text, message):
     with pytest.raises(ScenarioError, match=message):
         _load(tmp_path, f"pipeline:\n  perception: !DepthPerception {{{text}}}\n")
+
+
+def test_the_pipeline_puts_the_sensor_between_camera_and_perception(tmp_path):
+    from tg_drake.diagram import add_pipeline
+
+    s = _load(tmp_path, "pipeline:\n  perception: !DepthPerception {sensor: !StructuredLight {}}\n")
+    builder = DiagramBuilder()
+    pipeline = add_pipeline(builder, scenario=s)
+    diagram = builder.Build()
+    noise = diagram.GetSubsystemByName("depth_noise")
+    assert isinstance(noise.model, StructuredLight)
+    sources = {(dst.get_name(), int(i)): (src.get_name(), int(j))
+               for (dst, i), (src, j) in diagram.connection_map().items()}
+    depth_in = pipeline.perception.get_depth_image_input_port().get_index()
+    assert sources[("perception", int(depth_in))][0] == "depth_noise"
+    assert sources[("depth_noise", 0)][0] == "rgbd_sensor_camera0"

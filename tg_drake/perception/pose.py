@@ -1,8 +1,8 @@
 """Object pose on the table: upright, sideways or upside-down, with a likelihood.
 
 Vertical versus horizontal symmetry axis comes from the completion (paper assumption f: the
-direction of the axis gives the pose); its likelihood is the confidence of that decision
-(`Completion.axis_margin`). Which end of the axis is the object's top uses these cues, in order:
+direction of the axis gives the pose). Which end of the axis is the object's top uses these cues,
+in order:
 
 1. **Cavity.** An open container shows its inside through its opening: visible surface whose
    normal (oriented towards the camera, i.e. into free space) points *into* the object — towards
@@ -18,32 +18,38 @@ direction of the axis gives the pose); its likelihood is the confidence of that 
    table (already at mid-height, or strongly at the top: a can's rolled rim narrows only its last
    centimetre, and only a little), is the shape of a tapered open container (glass, cup, bowl,
    pan) resting on its rim: upside-down.
-5. Otherwise (closed and straight, like a can) the object is upright with a weak likelihood:
-   standing upright is the usual pose (the paper's S_GRASP and S_ROBOT scenes use only upright
-   and sideways), and an upside-down straight container looks the same from above.
+5. Otherwise (closed and straight, like a can) the object is taken as upright: standing upright
+   is the usual pose, and an upside-down straight container looks the same from above (the
+   calibrated likelihood of this cue says how often that is wrong).
 
 For a horizontal axis without a cavity or a handle at one end, the narrower end is the top (the
 neck of a bottle lying down); equal ends keep the axis direction.
 
+The likelihood is not set by hand: it is P(true pose | decision, cue) counted on perceived
+views of the training objects (`PoseCalibration`, `tools/calibrate_pose.py`), so a cue that is
+often wrong (a taper, a straight closed body) spreads its likelihood as often as it is wrong.
 The thresholds of the cues (`PoseConfig`) were chosen on renders of our object library.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import functools
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
+from tg_drake.errors import PerceptionError
 from tg_drake.perception.completion import Completion
 from tg_drake.perception.config import PoseConfig
 from tg_drake.types import POSES
 
-# P(upright) given each cue, for a vertical axis (see the module docstring).
-P_UPRIGHT_CAVITY = 0.95
-P_UPRIGHT_HANDLE = 0.85
-P_UPRIGHT_NECK = 0.9
-P_UPRIGHT_TAPER = 0.3
-P_UPRIGHT_STRAIGHT = 0.6
+# The likelihood of each pose given the decision and the cue that made it is calibrated, not set:
+# `tools/calibrate_pose.py` perceives the training objects' views (the object-wise split's
+# training set) through the default depth sensor and counts the true pose per (decision, cue);
+# `PoseCalibration` turns the counts into probabilities. The shipped counts:
+CALIBRATION_FILE = Path(__file__).resolve().parents[1] / "data" / "pose_likelihood.json"
 # P(interior seen) when the inward-facing share says so: as sure as the cavity cue's P(upright).
 P_INTERIOR = 0.95
 
@@ -62,6 +68,51 @@ END_SLICE = 0.15
 HANDLE_END = 0.4
 # Two ends whose radii differ by less than this share are equal.
 EQUAL_ENDS = 0.05
+
+
+@dataclass(frozen=True)
+class PoseCalibration:
+    """Counts of the true pose among perceived training views, per (decision, cue) key
+    ("upright/cavity", "sideways/tool", ...), and how many views' weight the prior has.
+
+    The likelihood of a key is its counts smoothed towards the counts of its decision (all cues
+    pooled), those towards uniform, each with `prior_views` pseudo-views: a key seen rarely
+    says little more than its decision, one never seen says its decision's frequencies.
+    """
+
+    counts: dict = field(default_factory=dict)  # key → {pose: count}
+    prior_views: float = 2.0  # [views] weight of the smoothing prior
+    source: str = ""  # how the counts were made (objects, sensor, command)
+
+    def likelihood(self, decision: str, cue: str) -> dict[str, float]:
+        """P(true pose | decision, cue), over POSES (sums to 1)."""
+        a = self.prior_views
+        pooled = np.zeros(len(POSES))
+        for key, c in self.counts.items():
+            if key.split("/")[0] == decision:
+                pooled += [c.get(p, 0) for p in POSES]
+        p_decision = (pooled + a / len(POSES)) / (pooled.sum() + a)
+        own = np.array([self.counts.get(f"{decision}/{cue}", {}).get(p, 0) for p in POSES],
+                       float)
+        p = (own + a * p_decision) / (own.sum() + a)
+        return {k: float(v) for k, v in zip(POSES, p, strict=True)}
+
+
+@functools.cache
+def load_pose_calibration(path: str = "") -> PoseCalibration:
+    """The calibration in `path` ("" = the shipped CALIBRATION_FILE); with no file at all, no
+    counts (every likelihood uniform: what the calibration tool starts from)."""
+    file = Path(path) if path else CALIBRATION_FILE
+    if not file.is_file():
+        if path:
+            raise PerceptionError(f"no such pose calibration file {path!r}")
+        return PoseCalibration()
+    try:
+        d = json.loads(file.read_text())
+        return PoseCalibration(counts=d["counts"], prior_views=float(d["prior_views"]),
+                               source=d.get("source", ""))
+    except (ValueError, KeyError, TypeError) as e:
+        raise PerceptionError(f"{file}: not a pose calibration ({e})") from None
 
 
 @dataclass
@@ -113,14 +164,11 @@ def _handle_end(c: Completion) -> int:
     return 1 if f > 1.0 - HANDLE_END else (-1 if f < HANDLE_END else 0)
 
 
-def tool_pose(c: Completion) -> PoseEstimate:
-    """A tool lies on the table: sideways, as sure as the axis (or, for a long-handled tool on
-    its head, the circle test) is."""
-    p = c.axis_margin if c.circle is None else max(c.axis_margin, c.circle.confidence)
-    rest = 1.0 - p
-    return PoseEstimate("sideways", {"upright": rest * P_UPRIGHT_STRAIGHT, "sideways": p,
-                                     "upsidedown": rest * (1.0 - P_UPRIGHT_STRAIGHT)}, 1.0,
-                        "tool")
+def tool_pose(c: Completion, cfg: PoseConfig | None = None) -> PoseEstimate:
+    """A tool lies on the table: sideways, with the calibrated likelihood of that decision."""
+    cfg = cfg or PoseConfig()
+    return PoseEstimate("sideways", load_pose_calibration(cfg.calibration).likelihood(
+        "sideways", "tool"), 1.0, "tool")
 
 
 def interior_seen(pose: PoseEstimate, is_tool: bool, cfg: PoseConfig | None = None) -> float:
@@ -152,8 +200,8 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
         cfg: pose parameters.
 
     The pose is decided hierarchically, as the paper does (assumption f): the axis direction
-    first (vertical or horizontal, with the axis decision's confidence), then the top end. The
-    likelihood spreads each decision's uncertainty over the poses.
+    first (vertical or horizontal), then the top end by the first cue that tells it. The
+    likelihood is the calibrated P(true pose | decision, cue) (`PoseCalibration`).
     """
     cfg = cfg or PoseConfig()
     vis = c.visible & ~c.handle
@@ -164,21 +212,18 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
     r_low, r_mid, r_high = _profile_radii(c)
     handle_end = _handle_end(c)
     if c.vertical:
+        # The cue that places the top, and which end it says.
         if cavity:
-            p_up, cue = P_UPRIGHT_CAVITY, "cavity"
+            top_sign, cue = 1.0, "cavity"
         elif handle_end != 0:
-            p_up, cue = (P_UPRIGHT_HANDLE if handle_end > 0 else 1 - P_UPRIGHT_HANDLE), "handle"
+            top_sign, cue = float(handle_end), "handle"
         elif r_high < cfg.neck_ratio * r_low and r_mid >= cfg.neck_body_ratio * r_low:
-            p_up, cue = P_UPRIGHT_NECK, "neck"
+            top_sign, cue = 1.0, "neck"
         elif r_high < cfg.taper_ratio * r_low and (r_mid < cfg.taper_body_ratio * r_low
                                                    or r_high < cfg.strong_taper_ratio * r_low):
-            p_up, cue = P_UPRIGHT_TAPER, "taper"
+            top_sign, cue = -1.0, "taper"
         else:
-            p_up, cue = P_UPRIGHT_STRAIGHT, "straight"
-        p_axis = c.axis_margin
-        likelihood = {"upright": p_axis * p_up, "sideways": 1.0 - p_axis,
-                      "upsidedown": p_axis * (1.0 - p_up)}
-        top_sign = 1.0 if p_up >= 0.5 else -1.0
+            top_sign, cue = 1.0, "straight"
     else:
         if cavity:
             top_sign = 1.0 if (p_TC - c.p_TA) @ c.axis_T >= 0 else -1.0
@@ -190,11 +235,8 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
             cue = "neck"
         else:
             top_sign, cue = 1.0, "ends"
-        p_axis = c.axis_margin
-        rest = 1.0 - p_axis
-        likelihood = {"upright": rest * P_UPRIGHT_STRAIGHT, "sideways": p_axis,
-                      "upsidedown": rest * (1.0 - P_UPRIGHT_STRAIGHT)}
-    total = sum(likelihood.values())
     pose = "sideways" if not c.vertical else ("upright" if top_sign > 0 else "upsidedown")
+    likelihood = load_pose_calibration(cfg.calibration).likelihood(pose, cue)
+    total = sum(likelihood.values())
     return PoseEstimate(pose, {k: likelihood[k] / total for k in POSES}, top_sign, cue,
                         int(inward.sum()), float(inward.mean()) if len(inward) else 0.0)
