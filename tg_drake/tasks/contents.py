@@ -35,6 +35,7 @@ SPHERE_DISSIPATION = 5.0  # [s/m] Hunt–Crossley dissipation, measured (little 
 SPHERE_FRICTION = 0.3  # [1] static = dynamic Coulomb friction: a loose granular fill
 DISPENSER_COUNT = 20  # [1] spheres in a dispenser by default
 DISPENSER_WIDTH = 0.045  # [m] inner side of the dispenser's square hopper by default
+DISPENSER_WALL = 0.004  # [m] thickness of the hopper's walls and of its gate
 
 LATTICE_GAP = 0.05  # [1] lattice spacing = 2·radius·(1 + gap): spheres start apart
 CLEARANCE = 1.1  # [1] a start site is at least this many radii from the container's mesh
