@@ -32,8 +32,9 @@ CONTENTS_MODELS = ("mass", "spheres")
 # plant steps (20 spheres at 2.5 / 5 / 10 ms: 6.9 / 4.2 / 2.3), and barely with the modulus or the
 # resolution hint; every setting kept every sphere in the standing cup and poured every one out of
 # the turned cup (radius 6 mm: one of 20 bounced off the table). The scripted pour of
-# tg_drake.simulation.pour costs 9.5× the same run with the mass contents with 20 spheres at the
-# 5 ms step, 3.3× with 10 at 10 ms.
+# tg_drake.simulation.pour (build included) costs, in CPU seconds, 2.6× the same run with the
+# mass contents with 10 spheres at the 5 ms step, 5.5× with 20 (wall time: 2.2× and 3.2× in
+# single runs, 9.5× the median of the bench's three with 20 on a heavily loaded machine).
 SPHERE_RADIUS = 0.008  # [m] measured: 14–36 lattice sites in the library's cups and glasses
 # (10 mm: 4–18, too coarse a measure of a poured fraction)
 MAX_SPHERES = 10  # [1] measured: a fill is at most this many spheres (the lowest sites first);
