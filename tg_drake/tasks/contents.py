@@ -33,8 +33,8 @@ CONTENTS_MODELS = ("mass", "spheres")
 # resolution hint; every setting kept every sphere in the standing cup and poured every one out of
 # the turned cup (radius 6 mm: one of 20 bounced off the table). The scripted pour of
 # tg_drake.simulation.pour (build included) costs, in CPU seconds, 2.6× the same run with the
-# mass contents with 10 spheres at the 5 ms step, 5.5× with 20 (wall time: 2.2× and 3.2× in
-# single runs, 9.5× the median of the bench's three with 20 on a heavily loaded machine).
+# mass contents with 10 spheres at the 5 ms step, 5.5× with 20 (wall time on a heavily loaded
+# machine: the bench's median of three 4.6× with 10, 9.5× with 20).
 SPHERE_RADIUS = 0.008  # [m] measured: 14–36 lattice sites in the library's cups and glasses
 # (10 mm: 4–18, too coarse a measure of a poured fraction)
 MAX_SPHERES = 10  # [1] measured: a fill is at most this many spheres (the lowest sites first);
