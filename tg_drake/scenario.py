@@ -47,7 +47,12 @@ from tg_drake.robot import WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
 from tg_drake.robot_plants import default_directives
 from tg_drake.schema_check import SchemaError, check_document, load_raw
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, table_size_problem
-from tg_drake.tasks.contents import ContentsConfig, DispenserConfig, container_sites
+from tg_drake.tasks.contents import (
+    DISPENSER_WALL,
+    ContentsConfig,
+    DispenserConfig,
+    container_sites,
+)
 from tg_drake.types import CATEGORIES, CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 # The WSG body frame G on the iiwa's link 7 (tg_drake.robot: the mount).
@@ -834,8 +839,18 @@ def _validate_contents(scenario: Scenario) -> None:
     """The contents block, the dispenser, and (spheres) that each full container's cavity holds
     its spheres."""
     scenario.contents.validate()
-    if scenario.dispenser is not None:
-        scenario.dispenser.validate(scenario.table_size, scenario.contents)
+    d = scenario.dispenser
+    if d is not None:
+        d.validate(scenario.table_size, scenario.contents)
+        for i, placement in enumerate(scenario.objects):
+            # The hopper's footprint (its width and walls) must stand clear above the object.
+            p = _footprint_points(scenario, placement)
+            under = np.all(np.abs(p[:, :2] - d.xy) <= d.width / 2 + DISPENSER_WALL, axis=1)
+            if np.any(under) and p[under, 2].max() >= d.height:
+                raise ScenarioError(
+                    f"the dispenser's gate at height {d.height} m is inside "
+                    f"{placement.instance_name} (objects[{i}]), which reaches "
+                    f"{p[under, 2].max():.3f} m under it; raise it", field="dispenser.height")
     if scenario.contents.model != "spheres":
         return
     for i, placement in enumerate(scenario.objects):

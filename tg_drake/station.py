@@ -95,6 +95,7 @@ from tg_drake.scenario import (
 )
 from tg_drake.table import add_table
 from tg_drake.tasks.contents import (
+    DISPENSER_WALL,
     ContentsConfig,
     ContentsModel,
     DispenserConfig,
@@ -227,7 +228,6 @@ def _add_contents(plant: MultibodyPlant, instance, body, obj) -> None:
 
 SPHERE_COLOR = (0.2, 0.45, 0.9, 1.0)  # RGBA of the contents' spheres (Meshcat)
 DISPENSER_COLOR = (0.6, 0.6, 0.65, 0.5)  # RGBA of the hopper and its gate
-DISPENSER_WALL = 0.004  # [m] thickness of the hopper's walls and gate
 GATE_GAP = 0.001  # [m] between the walls' bottom and the gate's top, so the gate slides free
 GATE_MASS = 0.2  # [kg]
 GATE_KP = 400.0  # [N/m] PD gains of the gate's slide (it opens by one width in ~0.3 s)

@@ -117,6 +117,7 @@ def test_counts_follow_the_container_frame_and_sum_to_every_sphere():
     ("dispenser: {xy: [0.0, 0.0], height: -0.1}", "dispenser.height"),
     ("dispenser: {xy: [0.0, 0.0], count: -3}", "dispenser.count"),
     ("dispenser: {xy: [0.0, 0.0], width: 0.01}", "dispenser.width"),
+    ("dispenser: {xy: [0.0, 0.0], height: 0.05}\nobjects: [{id: cup_01}]", "dispenser.height"),
 ])
 def test_bad_contents_and_dispensers_name_their_field(text, field):
     with pytest.raises(ScenarioError) as e:

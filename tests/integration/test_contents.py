@@ -117,3 +117,18 @@ def test_the_dispenser_drops_its_spheres_into_the_bowl_below_only_when_open(open
         assert counts == {BOWL: 12, "table": 0, "floor": 0, "elsewhere": 0}
     else:
         assert counts == {BOWL: 0, "table": 0, "floor": 0, "elsewhere": 12}
+
+
+def test_the_camera_sees_a_full_cup_of_spheres_as_a_full_cup_of_water():
+    # The spheres are drawn in Meshcat only: perception sees the same image for either model.
+    images = []
+    for model in ("mass", "spheres"):
+        scenario = load_scenario(scenario_text=f"""
+objects: [{{id: {CUP}, xy: [0.0, 0.0], containment: full}}]
+contents: {{model: {model}}}
+""")
+        diagram, station = make_station(scenario)
+        context = diagram.CreateDefaultContext()
+        images.append(np.array(diagram.GetOutputPort("camera0.depth_image").Eval(context).data))
+    assert np.isfinite(images[0]).any()
+    assert np.array_equal(images[0], images[1], equal_nan=True)

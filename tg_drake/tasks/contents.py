@@ -25,16 +25,29 @@ from tg_drake.objects import mesh as object_mesh
 
 CONTENTS_MODELS = ("mass", "spheres")
 
-# Defaults chosen by measurement (tests/integration/test_contents.py, the report of issue 21:
-# wall time per simulated second of a full cup, spill and tunnelling in the pour rig).
-SPHERE_RADIUS = 0.008  # [m] measured
-MAX_SPHERES = 20  # [1] measured: a fill at most this many spheres (the lowest lattice sites)
-SPHERE_MODULUS = 1e7  # [Pa] hydroelastic modulus, measured
-SPHERE_RESOLUTION = 0.016  # [m] hydroelastic mesh resolution hint (a coarse sphere), measured
-SPHERE_DISSIPATION = 5.0  # [s/m] Hunt–Crossley dissipation, measured (little bounce)
+# Defaults chosen by measurement (tools/measure_contents.py: a full library cup standing in the
+# station, robot idle, and turned upside down 0.25 m above the table by the tilt rig; CPU seconds
+# per simulated second on a shared 2-core machine, the mass model 0.46). The cost grows about
+# linearly with the number of spheres (10: 2.0, 20: 4.2, 36: 7.4 standing) and with the number of
+# plant steps (20 spheres at 2.5 / 5 / 10 ms: 6.9 / 4.2 / 2.3), and barely with the modulus or the
+# resolution hint; every setting kept every sphere in the standing cup and poured every one out of
+# the turned cup (radius 6 mm: one of 20 bounced off the table). The scripted pour of
+# tg_drake.simulation.pour (build included) costs, in CPU seconds, 2.6× the same run with the
+# mass contents with 10 spheres at the 5 ms step, 5.5× with 20 (wall time on a heavily loaded
+# machine: the bench's median of three 4.6× with 10, 9.5× with 20).
+SPHERE_RADIUS = 0.008  # [m] measured: 14–36 lattice sites in the library's cups and glasses
+# (10 mm: 4–18, too coarse a measure of a poured fraction)
+MAX_SPHERES = 10  # [1] measured: a fill is at most this many spheres (the lowest sites first);
+# the cost is proportional to it, and 10 still resolves a poured fraction to 0.1
+SPHERE_MODULUS = 1e7  # [Pa] hydroelastic modulus, measured (1e6: a sphere sinks 3.5 mm of its
+# 8 mm radius into the table; 1e8: no cheaper)
+SPHERE_RESOLUTION = 0.016  # [m] hydroelastic mesh resolution hint (the coarsest sphere), measured
+# (4 mm doubled the pour's cost)
+SPHERE_DISSIPATION = 5.0  # [s/m] Hunt–Crossley dissipation (little bounce)
 SPHERE_FRICTION = 0.3  # [1] static = dynamic Coulomb friction: a loose granular fill
-DISPENSER_COUNT = 20  # [1] spheres in a dispenser by default
+DISPENSER_COUNT = MAX_SPHERES  # [1] spheres in a dispenser by default
 DISPENSER_WIDTH = 0.045  # [m] inner side of the dispenser's square hopper by default
+DISPENSER_WALL = 0.004  # [m] thickness of the hopper's walls and of its gate
 
 LATTICE_GAP = 0.05  # [1] lattice spacing = 2·radius·(1 + gap): spheres start apart
 CLEARANCE = 1.1  # [1] a start site is at least this many radii from the container's mesh
