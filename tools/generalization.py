@@ -22,7 +22,7 @@ from tg_drake.evaluation.generalization import compute, markdown
 from tg_drake.evaluation.split import load_split
 
 COMMAND = ("nice -n 10 tg-drake eval scenarios/suites/generalization.yaml --out /tmp/gen\n"
-           "# scan-like columns: the libraries first (scenarios/suites/generalization_scanlike.yaml)\n"
+           "# scan-like columns: their libraries, then their suite\n"
            "python tools/make_scanlike.py --all --import\n"
            "python tools/make_scanlike.py --all --import --library models/objects_b\n"
            "nice -n 10 tg-drake eval scenarios/suites/generalization_scanlike.yaml --out "
