@@ -49,7 +49,9 @@ def check_result_keys(result: dict) -> None:
         g = result["grasp"]
         assert len(g["xyz"]) == 3 and len(g["rpy"]) == 3
         assert g["part"] in PART_LABELS
-        assert g["score"] == pytest.approx(g["p_part"] * g["p_local"], rel=1e-6)
+        # The executed pose's score: P(part | task) · P(grasp | local shape) · P(hold).
+        p_hold = 1.0 if g.get("p_hold") is None else g["p_hold"]
+        assert g["score"] == pytest.approx(g["p_part"] * g["p_local"] * p_hold, rel=1e-6)
     assert all(v >= 0 for v in result["timings"].values())
 
 
