@@ -37,8 +37,9 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.grasping.model import load_model
-from tg_drake.objects import box_centre
-from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario
+from tg_drake.objects import box_centre, get_object
+from tg_drake.planning.task_motion import surfaces_in_world, task_placing
+from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario, place_surface
 from tg_drake.station import Station, add_station, placement_pose
 from tg_drake.systems.dgi_system import DgiScoringSystem
 from tg_drake.systems.grasp_planner import GraspPlanner
@@ -46,6 +47,7 @@ from tg_drake.systems.kernel_prior_system import KernelPriorSystem
 from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
 from tg_drake.systems.perception_system import GroundTruthPerception, PerceptionSystem
 from tg_drake.systems.supervisor import MonitorModel, Supervisor
+from tg_drake.table import surface_body_name
 from tg_drake.targeting import select_target
 from tg_drake.types import SceneDescription
 
@@ -151,9 +153,17 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     supervision = config.supervisor
     X_WT = scenario.X_WT.GetDeterministicValue()
     place_xy_W = (X_WT @ np.array([*scenario.task.place_xy, 0.0, 1.0]))[:2]
+    # The task's placing: a resting pose to turn the object into, or a surface to put it on.
+    surfaces = surfaces_in_world(scenario.surfaces, X_WT.GetAsMatrix4())
+    surface = place_surface(scenario)
+    placing = task_placing(scenario.task.task, place_xy=place_xy_W,
+                           table_z=float(X_WT.translation()[2]),
+                           surface=next((s for s in surfaces if surface is not None
+                                         and s.name == surface.name), None),
+                           config=config.tasks)
     planner = builder.AddNamedSystem("planner", GraspPlanner(
         place_xy=place_xy_W, start_time=supervision.planning_start + supervision.period,
-        config=config.planner, scenario=scenario))
+        config=config.planner, scenario=scenario, placing=placing, surfaces=surfaces))
     builder.Connect(scene, planner.GetInputPort("scene_description"))
     builder.Connect(scoring.GetOutputPort("ranked_grasps"), planner.GetInputPort("ranked_grasps"))
     builder.Connect(station.outputs["iiwa.state"], planner.GetInputPort("iiwa.state"))
@@ -166,7 +176,10 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
         config=supervision, model=MonitorModel.from_plant(
             plant, object_body=station.object_body(target_placement.instance_name),
             wsg_instance=station.instances["wsg"], table_instance=station.instances["table"],
-            p_OC=box_centre(target_placement.id))))
+            p_OC=box_centre(target_placement.id), X_WT=X_WT.GetAsMatrix4(),
+            is_tool=get_object(target_placement.id).is_tool,
+            surfaces=[(s.name, surface_body_name(s.name)) for s in scenario.surfaces]),
+        task=scenario.task.task, place_on=surface.name if surface is not None else ""))
     builder.Connect(scene, supervisor.GetInputPort("scene_description"))
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     supervisor.GetInputPort("grasp_semantics"))

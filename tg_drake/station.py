@@ -74,7 +74,7 @@ from tg_drake.scenario import (
     WsgPdDriver,
     resolve_objects,
 )
-from tg_drake.table import add_table
+from tg_drake.table import add_surfaces, add_table
 
 WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container
 NO_LCM = "memq://null"  # the LCM URL that publishes nothing: the station sends no messages
@@ -212,6 +212,7 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
                             field="directives")
     X_WT = scenario.X_WT.GetDeterministicValue()
     instances["table"] = add_table(plant, scenario.table_size, X_WT)
+    add_surfaces(plant, instances["table"], scenario.surfaces)
     objects = _add_objects(scenario, plant, parser)
     instances.update(objects)
 

@@ -47,6 +47,7 @@ from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
+from tg_drake.planning.task_motion import Surface, TaskPlacing
 from tg_drake.planning.trajectory import (
     SegmentConfig,
     SegmentLimits,
@@ -180,6 +181,8 @@ class Plan:
     X_WO_place: np.ndarray  # 4×4 object pose at release
     waypoints: dict  # name → (7,) iiwa configuration
     segments: tuple  # (name, t_start, t_end, min_clearance [m]) per moving segment
+    R_turn: np.ndarray | None = None  # 3×3 world-frame rotation the plan gives the object
+    # beyond a turn about the vertical (a task's resting pose); None: its orientation is kept
 
     def q(self, t: float) -> np.ndarray:
         """(7,) joint positions at plan time t (held at the ends outside [0, duration])."""
@@ -240,7 +243,8 @@ def plan_for_scene(scene: SceneDescription, candidates: GraspCandidates, *, plac
 def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescription,
                         obstacles=(), place_xy, q_start=IIWA_HOME, table_z: float = 0.0,
                         config: PlannerConfig | None = None, scenario=None,
-                        exclude_parts=(), max_parts: int | None = None) -> PlanResult:
+                        exclude_parts=(), max_parts: int | None = None,
+                        placing: TaskPlacing | None = None, surfaces=()) -> PlanResult:
     """The first candidate (by score) with a full collision-free pick-and-place plan.
 
     Args:
@@ -253,6 +257,10 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         exclude_parts: part names not to try (already found unreachable).
         max_parts: try only the candidates of the first this many parts (in order of their best
             candidate); None tries all.
+        placing: the task's placing (`tg_drake.planning.task_motion.task_placing`: a resting
+            pose to turn the object into, a surface to put it on); None places it at `place_xy`
+            on the table, its orientation kept.
+        surfaces: `Surface` boxes standing on the table, obstacles of every motion.
     """
     config = config or PlannerConfig()
     t_start = time.perf_counter()
@@ -294,8 +302,14 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
     X_WO = np.asarray(target.X_WO, float)
     X_WO_place = place_pose(X_WO, target.extents, place_xy, table_z=table_z,
                             release_height=config.release_height)
+    if placing is not None:
+        place_xy = placing.place_xy
+        X_WO_place = place_pose(X_WO, target.extents, place_xy, table_z=placing.support_z,
+                                release_height=config.release_height)
     boxes = [(f"object{i}", RigidTransform(o.X_WO), tuple(o.extents))
              for i, o in enumerate(obstacles)]
+    boxes += [(f"surface_{s.name}", RigidTransform(np.asarray(s.X_WB)), tuple(s.size))
+              for s in surfaces]
     target_box = target_shapes(target)
     placed_box = ("target_placed", RigidTransform(X_WO_place), tuple(target.extents))
     arms = _Arms(scenario, config.open_width, boxes, target_box, placed_box)
@@ -323,8 +337,16 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             if not counted:  # this candidate reaches the inverse kinematics
                 tried[part] += 1
                 counted = True
-            for X_WO_place_yawed in _place_variants(X_WO_place, config):
-                key = _key_poses(arms, X_WG, X_WO, X_WO_place_yawed, config)
+            places = _task_place_variants(X_WO_place, config, placing=placing, X_WO=X_WO,
+                                          X_WG=X_WG, extents=target.extents,
+                                          is_tool=target.is_tool)
+            if not places:
+                costs[i] = np.inf
+                reasons[i] = _farthest(reasons[i], f"place pose: {target_name(target)} cannot "
+                                       f"be turned to rest {placing.pose}")
+                continue
+            for R_turn, X_WO_place_yawed in places:
+                key = _key_poses(arms, X_WG, X_WO, X_WO_place_yawed, config, R_turn=R_turn)
                 below = [n for n in ("pre-grasp", "grasp")
                          if key.X[n].translation()[2] < table_z]
                 if below:  # the WSG body's origin under the table top: no need to ask the IK
@@ -335,6 +357,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 poses, failure = _waypoint_configurations(arms, key, seeds, config)
                 if "pre-grasp" in poses:
                     part_reachable[part] = True
+                if failure and R_turn is not None and failure.startswith(PLACE_FAILURES):
+                    failure += (f", the object turned to rest {placing.pose} in the hand "
+                                "(a place-and-regrasp is not implemented)")
                 if failure:
                     # Failing on a place pose, the pick poses were reachable (motions untried):
                     # the object turned another way at the place may do.
@@ -347,6 +372,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 plan, failure, picked = _trajectories(arms, q_start, poses, key, config, seeds,
                                                       candidate=int(i), part=part)
                 part_pickable[part] |= picked
+                if plan is None and R_turn is not None and failure.startswith(PLACE_FAILURES):
+                    failure += (f", the object turned to rest {placing.pose} in the hand "
+                                "(a place-and-regrasp is not implemented)")
                 if plan is None:
                     costs[i], reasons[i] = np.inf, _farthest(reasons[i], failure)
                     if picked:
@@ -397,6 +425,29 @@ def _place_variants(X_WO_place: np.ndarray, config: PlannerConfig) -> list[np.nd
         X[:3, :3] = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]]) @ X_WO_place[:3, :3]
         out.append(X)
     return out
+
+
+def _task_place_variants(X_WO_place: np.ndarray, config: PlannerConfig, *,
+                         placing: TaskPlacing | None, X_WO: np.ndarray, X_WG: np.ndarray,
+                         extents, is_tool: bool = False) -> list[tuple]:
+    """(R_turn, X_WO_place) to try for grasp X_WG: the task's place poses (`placing`), each
+    turned about the vertical by `config.place_yaws` (`_place_variants`). R_turn is the world
+    rotation the plan gives the object when it turns it into another resting pose (the yaw
+    included), None when its orientation is kept."""
+    if placing is None:
+        return [(None, X) for X in _place_variants(X_WO_place, config)]
+    out = []
+    for R_turn, X_place in placing.place_poses(X_WO, X_WG, extents, is_tool=is_tool,
+                                               release_height=config.release_height,
+                                               place_pose=place_pose):
+        for X in _place_variants(X_place, config):
+            turn = None if R_turn is None else X[:3, :3] @ np.asarray(X_WO)[:3, :3].T
+            out.append((turn, X))
+    return out
+
+
+def target_name(target: ObjectDescription) -> str:
+    return target.name or "the object"
 
 
 # The open finger pads in G (tg_drake.robot: pads 0.012 × 0.082 × 0.02 m centred 0.055 m along
@@ -827,9 +878,10 @@ class _KeyPoses:
     X: dict  # name → RigidTransform X_WG, in execution order
     X_GO: RigidTransform  # the target in the hand
     X_WO_place: np.ndarray  # 4×4 object pose at the place pose
+    R_turn: np.ndarray | None = None  # the object's turn into a task's resting pose
 
 
-def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config) -> _KeyPoses:
+def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config, *, R_turn=None) -> _KeyPoses:
     X_WG = RigidTransform(X_WG)
     y_G = X_WG.rotation().col(1)
     up = np.array([0.0, 0.0, config.lift_height])
@@ -847,7 +899,7 @@ def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config) -> _KeyPoses:
          # Back out along the gripper's approach at the place (the object may have been turned
          # about the vertical there, turning the approach with it).
          "retreat": moved(X_WG_place, -config.retreat_distance * X_WG_place.rotation().col(1))}
-    return _KeyPoses(X, X_OG.inverse(), np.asarray(X_WO_place, float))
+    return _KeyPoses(X, X_OG.inverse(), np.asarray(X_WO_place, float), R_turn)
 
 
 def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
@@ -952,5 +1004,6 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
                 t_grasp_closed=t_grasp_closed, t_lift_done=t_lift_done,
                 t_place_done=t_place_done, duration=t, candidate=candidate, part=part,
                 X_WG_grasp=key.X["grasp"].GetAsMatrix4(),
-                X_WO_place=key.X_WO_place, waypoints=q, segments=tuple(rows))
+                X_WO_place=key.X_WO_place, waypoints=q, segments=tuple(rows),
+                R_turn=key.R_turn)
     return plan, "", True

@@ -15,6 +15,10 @@ every decision that spans stages is taken here, in simulated time, from port val
 3. **Monitor**: at the plan's key times (the first check at or after each): both pads hold the
    object when the gripper has closed (else "missed"), the object rose with the gripper during the
    lift (else "slipped"), and at the end it stands let go at the place target (else "lifted").
+4. **Task check** (when the scenario gives a task): at the end, the task's judge
+   (`tg_drake.tasks.judge`) on the object's simulated pose, its contacts and the contents'
+   counts gives `Outcome.task_outcome`; a run that ended before the end of its plan gets a failed
+   task outcome saying why.
 """
 
 
@@ -24,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.math import RigidTransform
+from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import ContactResults
 from pydrake.systems.framework import EventStatus, LeafSystem
 
@@ -37,9 +41,17 @@ from tg_drake.errors import (
     SimulationError,
     TgDrakeError,
 )
-from tg_drake.outcome import HandGeometries, hand_contact, placed, touches_table
+from tg_drake.outcome import (
+    HandGeometries,
+    contact_pairs,
+    hand_contact,
+    placed,
+    touches_table,
+)
 from tg_drake.scenario import SupervisorConfig
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
+from tg_drake.tasks.judge import REST_POSE_OF_TASK, judge_on_surface, judge_rest_pose
+from tg_drake.tasks.outcome import TaskOutcome
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 
@@ -89,6 +101,7 @@ class Outcome:
     reachable_parts: tuple = ()  # the part a plan was made for
     unreachable_parts: tuple = ()  # parts given to the logic as collision(Part) evidence
     requeries: int = 0  # how often the logic was asked again with new collision evidence
+    task_outcome: TaskOutcome | None = None  # the task's physical check (None: no task given)
 
     @property
     def final(self) -> bool:
@@ -98,7 +111,9 @@ class Outcome:
         """The JSON form (result.json's ``outcome``)."""
         return {"status": self.status.value, "reason": self.reason.value, "detail": self.detail,
                 "reachable_parts": list(self.reachable_parts),
-                "unreachable_parts": list(self.unreachable_parts), "requeries": self.requeries}
+                "unreachable_parts": list(self.unreachable_parts), "requeries": self.requeries,
+                "task_outcome": (self.task_outcome.as_dict() if self.task_outcome is not None
+                                 else None)}
 
 
 def outcome_of_error(error: Exception, *, pending: Outcome | None = None) -> Outcome:
@@ -109,28 +124,44 @@ def outcome_of_error(error: Exception, *, pending: Outcome | None = None) -> Out
         reason, detail = reason_of(error), str(error)
     else:
         reason, detail = Reason.simulation, f"the simulation failed: {error}"
-    return dataclasses.replace(pending, status=Status.failed, reason=reason, detail=detail)
+    task = pending.task_outcome
+    if task is not None:
+        task = TaskOutcome(task.task, False, {}, f"not done: the run failed ({reason}): {detail}")
+    return dataclasses.replace(pending, status=Status.failed, reason=reason, detail=detail,
+                               task_outcome=task)
 
 
 @dataclass(frozen=True)
 class MonitorModel:
     """What the execution monitor needs to know about the plant's model (read once, before
     simulating): the geometry ids of the target, fingers and table, the indices of the target's
-    and the gripper's bodies in ``body_poses``, and the target's box centre in its frame [m]."""
+    and the gripper's bodies in ``body_poses``, and the target's box centre in its frame [m];
+    for the task check: the table frame, whether the target is a tool, and the collision
+    geometry ids of each of the scenario's surfaces (by name; they belong to the table)."""
 
     geometries: HandGeometries
     object_body: int
     gripper_body: int
     p_OC: tuple = (0.0, 0.0, 0.0)
+    X_WT: tuple = tuple(map(tuple, np.eye(4)))  # 4×4 table frame, as nested tuples
+    is_tool: bool = False
+    surfaces: tuple = ()  # (name, frozenset of GeometryId) per surface
 
     @classmethod
     def from_plant(cls, plant, *, object_body, wsg_instance, table_instance,
-                   p_OC=(0.0, 0.0, 0.0)) -> "MonitorModel":
+                   p_OC=(0.0, 0.0, 0.0), X_WT=None, is_tool: bool = False,
+                   surfaces=()) -> "MonitorModel":
+        """`surfaces`: names of the surfaces' bodies in the table's model instance."""
+        surface_ids = tuple(
+            (name, frozenset(plant.GetCollisionGeometriesForBody(
+                plant.GetBodyByName(body, table_instance)))) for name, body in surfaces)
         return cls(HandGeometries.from_plant(plant, object_body=object_body,
                                              wsg_instance=wsg_instance,
                                              table_instance=table_instance),
                    int(object_body.index()), int(plant.GetBodyByName("body", wsg_instance).index()),
-                   tuple(float(v) for v in p_OC))
+                   tuple(float(v) for v in p_OC),
+                   tuple(map(tuple, np.eye(4) if X_WT is None else np.asarray(X_WT, float))),
+                   bool(is_tool), surface_ids)
 
 
 class Phase(enum.StrEnum):
@@ -193,11 +224,15 @@ class Supervisor(LeafSystem):
     leave out, for the planner) and ``outcome`` (`Outcome`; `Outcome.final` once decided).
     """
 
-    def __init__(self, *, config: SupervisorConfig | None = None, model: "MonitorModel"):
+    def __init__(self, *, config: SupervisorConfig | None = None, model: "MonitorModel",
+                 task: str = "", place_on: str = ""):
+        """`task`: the scenario's given task ("" = inferred: no task check); `place_on`: the
+        surface p&pOn places the object on."""
         super().__init__()
         self._config = config or SupervisorConfig()
         self._config.validate()
         self._model = model
+        self._task, self._place_on = task, place_on
 
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
@@ -285,12 +320,17 @@ class Supervisor(LeafSystem):
         return EventStatus.Succeeded()
 
     def _finish(self, memory: _Memory, status: Status, reason: Reason, detail: str,
-                **changes) -> _Memory:
+                task_outcome: TaskOutcome | None = None, **changes) -> _Memory:
         memory = dataclasses.replace(memory, **changes)
         reachable = (memory.status.part,) if memory.status is not None else ()
+        if task_outcome is None and self._task:
+            why = f"{status}" + (f" ({reason})" if reason else "")
+            task_outcome = TaskOutcome(self._task, False, {},
+                                       f"not done: the run ended {why}: {detail}")
         return dataclasses.replace(memory, phase=Phase.done, outcome=Outcome(
             status, reason, detail, reachable_parts=reachable,
-            unreachable_parts=memory.collisions, requeries=memory.requeries))
+            unreachable_parts=memory.collisions, requeries=memory.requeries,
+            task_outcome=task_outcome))
 
     def _gate(self, context, memory: _Memory) -> _Memory:
         scene: SceneDescription = self._scene_port.Eval(context)
@@ -386,11 +426,41 @@ class Supervisor(LeafSystem):
             return self._finish(memory, Status.failed, Reason.simulation,
                                 "the simulation diverged")
         on_table = touches_table(contacts, geometries=self._model.geometries)
-        ok, detail = placed(memory.X_WO_picked, X_WO, plan.X_WO_place[:2, 3],
+        X_WO_expected = memory.X_WO_picked
+        if plan.R_turn is not None:  # the plan turns the object into another resting pose
+            X_WO_expected = RigidTransform(
+                RotationMatrix(np.asarray(plan.R_turn)) @ memory.X_WO_picked.rotation(),
+                memory.X_WO_picked.translation())
+        ok, detail = placed(X_WO_expected, X_WO, plan.X_WO_place[:2, 3],
                             released=on_table and not hand.held, p_OC=self._model.p_OC)
+        task = self._task_check(X_WO, plan, contacts, released=not hand.held)
         if ok:
-            return self._finish(memory, Status.placed, Reason.none, detail)
-        return self._finish(memory, Status.lifted, Reason.slipped, detail)
+            return self._finish(memory, Status.placed, Reason.none, detail, task)
+        return self._finish(memory, Status.lifted, Reason.slipped, detail, task)
+
+    def _task_check(self, X_WO: RigidTransform, plan, contacts, *, released: bool
+                    ) -> TaskOutcome | None:
+        """The given task's judgement at the end of the plan (None when no task is given)."""
+        task, model = self._task, self._model
+        if not task:
+            return None
+        if task in REST_POSE_OF_TASK:
+            on_support = touches_table(contacts, geometries=model.geometries)
+            return judge_rest_pose(task, X_WO.GetAsMatrix4(), np.array(model.X_WT),
+                                   is_tool=model.is_tool, p_WC=X_WO.multiply(np.array(model.p_OC)),
+                                   target_xy=plan.X_WO_place[:2, 3],
+                                   released=released and on_support)
+        if task == "p&pOn":
+            surfaces = dict(model.surfaces)
+            if self._place_on not in surfaces:
+                return TaskOutcome(task, False, {}, "the scenario has no surface to place on")
+            table_top = model.geometries.table - frozenset().union(*surfaces.values())
+            on = {name: _touches(contacts, model.geometries.object, ids)
+                  for name, ids in (("surface", surfaces[self._place_on]), ("table", table_top))}
+            return judge_on_surface(self._place_on, on_surface=on["surface"],
+                                    on_table=on["table"], released=released)
+        return TaskOutcome(task, False, {}, f"the {task} motion and check are not implemented "
+                           "yet: the object was placed as for pick-and-place")
 
     # Outputs.
     def _memory_of(self, context) -> _Memory:
@@ -414,6 +484,11 @@ class Supervisor(LeafSystem):
         output.set_value(Outcome(Status.pending, Reason.none, waiting[memory.phase],
                                  unreachable_parts=memory.collisions,
                                  requeries=memory.requeries))
+
+
+def _touches(contact_results, a: frozenset, b: frozenset) -> bool:
+    """Does any geometry of `a` touch one of `b` (a hydroelastic surface or a point pair)?"""
+    return any((x in a and y in b) or (y in a and x in b) for x, y in contact_pairs(contact_results))
 
 
 def _why(failures: tuple) -> str:
