@@ -55,8 +55,8 @@ GRASPS = ranked([(FROM_BELOW, "bottom"), (TOP, "top")])
 class Fixed:
     """The supervisor alone, its inputs fixed; `advance` moves simulated time."""
 
-    def __init__(self, *, config=CONFIG, scene=SCENE, meaning=None, grasps=GRASPS):
-        self.supervisor = Supervisor(config=config, model=NO_MODEL)
+    def __init__(self, *, config=CONFIG, scene=SCENE, meaning=None, grasps=GRASPS, task=""):
+        self.supervisor = Supervisor(config=config, model=NO_MODEL, task=task)
         self.context = self.supervisor.CreateDefaultContext()
         s = self.supervisor
         s.get_scene_description_input_port().FixValue(self.context, scene)
@@ -103,6 +103,23 @@ def test_gate_passes_and_asks_for_the_first_plan():
     assert f.request == PlanRequest(attempt=1, exclude_parts=())
     assert (f.outcome.status, f.outcome.final) == (Status.pending, False)
     assert "attempt 1" in f.outcome.detail
+
+
+def test_a_given_task_gets_a_failed_task_outcome_when_the_run_ends_early():
+    f = Fixed(meaning=semantics(grasp_probability=0.01), task="p&pInUpsidedown")
+    f.advance(0.001)
+    task = f.outcome.task_outcome
+    assert f.outcome.final and task is not None
+    assert (task.task, task.success) == ("p&pInUpsidedown", False)
+    assert "not done" in task.detail and "logic" in task.detail
+    assert f.outcome.as_dict()["task_outcome"]["success"] is False
+
+
+def test_no_task_given_no_task_outcome():
+    f = Fixed(meaning=semantics(grasp_probability=0.01))
+    f.advance(0.001)
+    assert f.outcome.final and f.outcome.task_outcome is None
+    assert f.outcome.as_dict()["task_outcome"] is None
 
 
 @pytest.mark.parametrize("kwargs, detail", [

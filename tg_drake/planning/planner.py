@@ -47,7 +47,7 @@ from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
-from tg_drake.planning.task_motion import Surface, TaskPlacing
+from tg_drake.planning.task_motion import Surface, TaskPlacing, turned_retreat
 from tg_drake.planning.trajectory import (
     SegmentConfig,
     SegmentLimits,
@@ -899,6 +899,9 @@ def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config, *, R_turn=None) -> _
          # Back out along the gripper's approach at the place (the object may have been turned
          # about the vertical there, turning the approach with it).
          "retreat": moved(X_WG_place, -config.retreat_distance * X_WG_place.rotation().col(1))}
+    if R_turn is not None:
+        X["retreat"] = moved(X_WG_place, config.retreat_distance
+                             * turned_retreat(X_WG_place.rotation().col(1)))
     return _KeyPoses(X, X_OG.inverse(), np.asarray(X_WO_place, float), R_turn)
 
 

@@ -39,12 +39,17 @@ class TaskMotionConfig:
 
     reorient: bool = True  # p&pIn*: turn the object into the task's resting pose (False: place
     # it as picked, the task then judged on that)
+    turned_release_heights: list[float] = field(default_factory=lambda: [0.01, 0.03, 0.05])
+    # [m] gaps under a turned object's box at release, tried in order: turned upside down, a
+    # side grasp's approach points up, and the wrist stays clear of the table only higher up
     pour_tilt: float = 110.0  # [deg] pourOut: the container's axis turned this far from up
     pour_hold: float = 1.5  # [s] pourOut: held tilted over the bowl
     pour_clearance: float = 0.04  # [m] pourOut: the container's lowest point above the bowl's
 
     def validate(self, where: str = "pipeline.tasks") -> None:
-        checks = (("pour_tilt", 0.0 < self.pour_tilt <= 180.0, "in (0, 180] deg"),
+        checks = (("turned_release_heights", all(h >= 0.0 for h in self.turned_release_heights)
+                   and len(self.turned_release_heights) > 0, "a non-empty list of heights >= 0 m"),
+                  ("pour_tilt", 0.0 < self.pour_tilt <= 180.0, "in (0, 180] deg"),
                   ("pour_hold", self.pour_hold >= 0.0, ">= 0 s"),
                   ("pour_clearance", self.pour_clearance >= 0.0, ">= 0 m"))
         for name, ok, allowed in checks:
@@ -116,6 +121,17 @@ def turns_to_pose(R_WO: np.ndarray, R_WG: np.ndarray, pose: str, *, is_tool: boo
     return unique
 
 
+def turned_retreat(y_WG: np.ndarray) -> np.ndarray:
+    """The unit direction a gripper backs away in after releasing an object it turned: back along
+    its approach (−y_G), but never down (a turned object's approach may point up, and backing
+    along it would drive the wrist into the table): the downward part is dropped, straight up
+    when nothing is left."""
+    r = -np.asarray(y_WG, float)
+    r[2] = max(r[2], 0.0)
+    n = np.linalg.norm(r)
+    return r / n if n > 0.3 else UP.copy()
+
+
 def turned(X_WO: np.ndarray, R: np.ndarray) -> np.ndarray:
     """X_WO turned by the world rotation R about its own origin (the box centre)."""
     X = np.asarray(X_WO, float).copy()
@@ -159,7 +175,8 @@ class TaskPlacing:
     pose: str | None  # an entry of POSES, or None to keep the orientation
     place_xy: tuple
     support_z: float  # [m] world height of what the object is released onto
-    surface: str = ""  # the surface's name (p&pOn), else ""
+    surface: str = ""
+    turned_release_heights: tuple = (0.01,)  # [m] (TaskMotionConfig)  # the surface's name (p&pOn), else ""
 
     def place_poses(self, X_WO: np.ndarray, X_WG: np.ndarray, extents, *, is_tool: bool,
                     release_height: float, place_pose) -> list[tuple]:
@@ -173,10 +190,14 @@ class TaskPlacing:
         out = []
         for R in turns_to_pose(X_WO[:3, :3], np.asarray(X_WG, float)[:3, :3], self.pose,
                                is_tool=is_tool):
-            keep = np.allclose(R, np.eye(3))
-            out.append((None if keep else R,
-                        place_pose(turned(X_WO, R), extents, self.place_xy,
-                                   table_z=self.support_z, release_height=release_height)))
+            if np.allclose(R, np.eye(3)):
+                out.append((None, place_pose(X_WO, extents, self.place_xy,
+                                             table_z=self.support_z,
+                                             release_height=release_height)))
+                continue
+            for height in self.turned_release_heights:
+                out.append((R, place_pose(turned(X_WO, R), extents, self.place_xy,
+                                          table_z=self.support_z, release_height=height)))
         return out
 
 
@@ -189,4 +210,5 @@ def task_placing(task: str, *, place_xy, table_z: float, surface: Surface | None
     pose = REST_POSE_OF_TASK.get(task) if config.reorient else None
     if task == "p&pOn" and surface is not None:
         return TaskPlacing(task, None, tuple(surface.xy), surface.top_z, surface.name)
-    return TaskPlacing(task, pose, tuple(float(v) for v in place_xy), float(table_z))
+    return TaskPlacing(task, pose, tuple(float(v) for v in place_xy), float(table_z),
+                       turned_release_heights=tuple(config.turned_release_heights))

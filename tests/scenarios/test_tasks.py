@@ -1,0 +1,42 @@
+"""Every task scenario in scenarios/tasks/ runs through `run_scenario` and its task is judged by
+physics: the task outcome in result.json says it succeeded, with its measure."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+TASKS = Path(__file__).resolve().parents[2] / "scenarios" / "tasks"
+
+
+def test_every_task_scenario_is_a_case():
+    cases = {"can_on_shelf", "can_sideways", "can_upsidedown"}
+    assert {p.stem for p in TASKS.glob("*.yaml")} >= cases
+
+
+def task_outcome(cached_run, name: str) -> dict:
+    result = cached_run(TASKS / f"{name}.yaml", None)
+    assert result["outcome"]["task_outcome"] == result["task_outcome"]
+    return result["task_outcome"]
+
+
+def test_a_can_is_put_on_the_shelf(cached_run):
+    task = task_outcome(cached_run, "can_on_shelf")
+    assert task["task"] == "p&pOn"
+    assert task["success"], task
+    assert task["measure"] == {"surface": "shelf", "on_surface": True, "on_table": False}
+
+
+@pytest.mark.slow
+def test_an_upright_can_is_laid_on_its_side(cached_run):
+    task = task_outcome(cached_run, "can_sideways")
+    assert task["success"], task
+    assert task["measure"]["rest_pose"] == "sideways" and task["measure"]["distance_m"] < 0.05
+
+
+@pytest.mark.slow
+def test_an_upright_can_is_turned_upside_down_in_the_hand(cached_run):
+    task = task_outcome(cached_run, "can_upsidedown")
+    assert task["success"], task
+    assert task["measure"]["rest_pose"] == "upsidedown" and task["measure"]["distance_m"] < 0.05
