@@ -11,7 +11,7 @@ TASKS = Path(__file__).resolve().parents[2] / "scenarios" / "tasks"
 
 
 def test_every_task_scenario_is_a_case():
-    cases = {"can_on_shelf", "can_sideways", "can_upsidedown"}
+    cases = {"can_on_shelf", "can_sideways", "can_upsidedown", "glass_upright"}
     assert {p.stem for p in TASKS.glob("*.yaml")} >= cases
 
 
@@ -40,3 +40,10 @@ def test_an_upright_can_is_turned_upside_down_in_the_hand(cached_run):
     task = task_outcome(cached_run, "can_upsidedown")
     assert task["success"], task
     assert task["measure"]["rest_pose"] == "upsidedown" and task["measure"]["distance_m"] < 0.05
+
+
+@pytest.mark.slow
+def test_a_glass_lying_down_is_stood_up_in_the_hand(cached_run):
+    task = task_outcome(cached_run, "glass_upright")
+    assert task["success"], task
+    assert task["measure"]["rest_pose"] == "upright" and task["measure"]["distance_m"] < 0.05
