@@ -156,7 +156,11 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     # The task's placing: a resting pose to turn the object into, or a surface to put it on.
     surfaces = surfaces_in_world(scenario.surfaces, X_WT.GetAsMatrix4())
     surface = place_surface(scenario)
-    placing = task_placing(scenario.task.task, place_xy=place_xy_W,
+    pour_at = None  # the bowl's box centre, as the user points at it
+    for placement in scenario.objects:
+        if scenario.task.pour_into and placement.instance_name == scenario.task.pour_into:
+            pour_at = placement_pose(scenario, placement).multiply(box_centre(placement.id))[:2]
+    placing = task_placing(scenario.task.task, place_xy=place_xy_W, pour_at=pour_at,
                            table_z=float(X_WT.translation()[2]),
                            surface=next((s for s in surfaces if surface is not None
                                          and s.name == surface.name), None),
@@ -179,7 +183,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
             p_OC=box_centre(target_placement.id), X_WT=X_WT.GetAsMatrix4(),
             is_tool=get_object(target_placement.id).is_tool,
             surfaces=[(s.name, surface_body_name(s.name)) for s in scenario.surfaces]),
-        task=scenario.task.task, place_on=surface.name if surface is not None else ""))
+        task=scenario.task.task, place_on=surface.name if surface is not None else "",
+        pour_into=scenario.task.pour_into, container=target_placement.instance_name))
     builder.Connect(scene, supervisor.GetInputPort("scene_description"))
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     supervisor.GetInputPort("grasp_semantics"))

@@ -87,3 +87,29 @@ def test_an_upside_down_placing_tries_higher_releases():
 def test_a_bad_task_motion_config_names_its_field(field, value):
     with pytest.raises(ScenarioError, match=field):
         TaskMotionConfig(**{field: value}).validate()
+
+
+def test_a_pour_puts_the_opening_over_the_bowl_and_tilts_it_there():
+    from tg_drake.planning.task_motion import pour_poses
+
+    X_WO = np.eye(4)
+    X_WO[:3, 3] = [0.75, 0.0, 0.05]
+    X_WG = np.eye(4)
+    X_WG[:3, :3] = R_SIDE
+    extents, bowl_xy, bowl_top = [0.08, 0.08, 0.1], (0.7, -0.25), 0.06
+    pours = pour_poses(X_WO, extents, X_WG, bowl_xy=bowl_xy, bowl_top=bowl_top,
+                       tilt=np.deg2rad(110), clearance=0.05, yaws=(0.0, np.pi / 2))
+    assert len(pours) == 8  # 2 axes × 2 ways × 2 yaws
+    for X_pour, X_tilted in pours:
+        assert np.isclose(X_pour[2, 3] - 0.05, bowl_top + 0.05)  # the box bottom clears the bowl
+        assert X_pour[2, 2] > 0.99  # upright
+        assert np.isclose(X_tilted[:3, 2] @ [0, 0, 1], np.cos(np.deg2rad(110)))
+        # The opening's edge where it leans (the point the tilt keeps) is over the bowl's centre.
+        rim_centre = X_pour[:3, 3] + X_pour[:3, 2] * 0.05
+        lean = X_tilted[:3, 2] - (X_tilted[:3, 2] @ [0, 0, 1]) * np.array([0, 0, 1])
+        lean /= np.linalg.norm(lean)
+        assert np.allclose(rim_centre[:2] + 0.04 * lean[:2], bowl_xy, atol=1e-9)
+    lying = X_WO.copy()
+    lying[:3, :3] = LYING
+    assert pour_poses(lying, extents, X_WG, bowl_xy=bowl_xy, bowl_top=bowl_top,
+                      tilt=1.9, clearance=0.05) == []

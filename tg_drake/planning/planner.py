@@ -47,7 +47,14 @@ from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
-from tg_drake.planning.task_motion import Surface, TaskPlacing, turned_retreat
+from tg_drake.planning.task_motion import (
+    Surface,
+    TaskPlacing,
+    bowl_of,
+    box_top,
+    pour_poses,
+    turned_retreat,
+)
 from tg_drake.planning.trajectory import (
     SegmentConfig,
     SegmentLimits,
@@ -183,6 +190,8 @@ class Plan:
     segments: tuple  # (name, t_start, t_end, min_clearance [m]) per moving segment
     R_turn: np.ndarray | None = None  # 3×3 world-frame rotation the plan gives the object
     # beyond a turn about the vertical (a task's resting pose); None: its orientation is kept
+    t_pour: tuple | None = None  # [s] (start, end) of holding the container tilted over the
+    # bowl (pourOut); None when the plan pours nothing
 
     def q(self, t: float) -> np.ndarray:
         """(7,) joint positions at plan time t (held at the ends outside [0, duration])."""
@@ -345,8 +354,17 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 reasons[i] = _farthest(reasons[i], f"place pose: {target_name(target)} cannot "
                                        f"be turned to rest {placing.pose}")
                 continue
-            for R_turn, X_WO_place_yawed in places:
-                key = _key_poses(arms, X_WG, X_WO, X_WO_place_yawed, config, R_turn=R_turn)
+            pours, why = _pours(placing, obstacles, target, X_WG)
+            if not pours:
+                costs[i], reasons[i] = np.inf, _farthest(reasons[i], why)
+                continue
+            failed_pours = set()
+            for k_pour, pour, R_turn, X_WO_place_yawed in [
+                    (k, pour, R, X) for k, pour in enumerate(pours) for R, X in places]:
+                if k_pour in failed_pours:
+                    continue
+                key = _key_poses(arms, X_WG, X_WO, X_WO_place_yawed, config, R_turn=R_turn,
+                                 pour=pour, pour_hold=placing.pour_hold if pour else 0.0)
                 below = [n for n in ("pre-grasp", "grasp")
                          if key.X[n].translation()[2] < table_z]
                 if below:  # the WSG body's origin under the table top: no need to ask the IK
@@ -360,6 +378,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 if failure and R_turn is not None and failure.startswith(PLACE_FAILURES):
                     failure += (f", the object turned to rest {placing.pose} in the hand "
                                 "(a place-and-regrasp is not implemented)")
+                if failure.startswith(POUR_FAILURES):  # another pour may do
+                    failed_pours.add(k_pour)
                 if failure:
                     # Failing on a place pose, the pick poses were reachable (motions untried):
                     # the object turned another way at the place may do.
@@ -376,6 +396,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                     failure += (f", the object turned to rest {placing.pose} in the hand "
                                 "(a place-and-regrasp is not implemented)")
                 if plan is None:
+                    if failure.startswith(POUR_FAILURES):
+                        failed_pours.add(k_pour)
                     costs[i], reasons[i] = np.inf, _farthest(reasons[i], failure)
                     if picked:
                         continue
@@ -444,6 +466,25 @@ def _task_place_variants(X_WO_place: np.ndarray, config: PlannerConfig, *,
             turn = None if R_turn is None else X[:3, :3] @ np.asarray(X_WO)[:3, :3].T
             out.append((turn, X))
     return out
+
+
+def _pours(placing: TaskPlacing | None, obstacles, target: ObjectDescription,
+           X_WG: np.ndarray) -> tuple[list, str]:
+    """The pours to try for grasp X_WG (`task_motion.pour_poses`: (X_WO_pour, X_WO_tilted)),
+    [None] when the task pours nothing; ([], why) when it cannot pour."""
+    if placing is None or placing.pour_at is None:
+        return [None], ""
+    k = bowl_of(obstacles, placing.pour_at)
+    if k is None:
+        return [], "pour pose: no object perceived to pour into"
+    bowl = obstacles[k]
+    pours = pour_poses(np.asarray(target.X_WO, float), target.extents, X_WG,
+                       bowl_xy=placing.pour_at, bowl_top=box_top(bowl.X_WO, bowl.extents),
+                       tilt=placing.pour_tilt, clearance=placing.pour_clearance,
+                       yaws=placing.pour_yaws)
+    if not pours:
+        return [], f"pour pose: {target_name(target)} is not upright"
+    return pours, ""
 
 
 def target_name(target: ObjectDescription) -> str:
@@ -554,7 +595,10 @@ GRASP_DEPTH = float(WSG_GRASP_POINT_G[1])  # [m] the grasp point lies this far a
 PICK_POSES = {"pre-grasp", "grasp", "lift"}
 PICK_MOTIONS = ("move", "approach", "lift")
 PLACE_FAILURES = ("pre-place pose", "place pose", "retreat pose", "carry trajectory",
-                  "descend trajectory", "retreat trajectory")  # how their reasons start
+                  "descend trajectory", "retreat trajectory", "pour pose", "tilted pose",
+                  "tilt trajectory", "untilt trajectory", "return trajectory")  # how their
+# reasons start
+POUR_FAILURES = ("pour pose", "tilted pose", "tilt trajectory", "untilt trajectory")
 
 
 class _Arms:
@@ -879,9 +923,11 @@ class _KeyPoses:
     X_GO: RigidTransform  # the target in the hand
     X_WO_place: np.ndarray  # 4×4 object pose at the place pose
     R_turn: np.ndarray | None = None  # the object's turn into a task's resting pose
+    pour_hold: float = 0.0  # [s] held tilted (when X has "pour" and "tilted")
 
 
-def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config, *, R_turn=None) -> _KeyPoses:
+def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config, *, R_turn=None, pour=None,
+               pour_hold: float = 0.0) -> _KeyPoses:
     X_WG = RigidTransform(X_WG)
     y_G = X_WG.rotation().col(1)
     up = np.array([0.0, 0.0, config.lift_height])
@@ -902,7 +948,15 @@ def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config, *, R_turn=None) -> _
     if R_turn is not None:
         X["retreat"] = moved(X_WG_place, config.retreat_distance
                              * turned_retreat(X_WG_place.rotation().col(1)))
-    return _KeyPoses(X, X_OG.inverse(), np.asarray(X_WO_place, float), R_turn)
+    if pour is not None:  # over the bowl after the lift: upright, then tilted
+        X_WO_pour, X_WO_tilted = pour
+        order = list(X)
+        at = order.index("lift") + 1
+        poses = dict(pour=RigidTransform(X_WO_pour) @ X_OG,
+                     tilted=RigidTransform(X_WO_tilted) @ X_OG)
+        X = {n: (X[n] if n in X else poses[n])
+             for n in order[:at] + ["pour", "tilted"] + order[at:]}
+    return _KeyPoses(X, X_OG.inverse(), np.asarray(X_WO_place, float), R_turn, pour_hold)
 
 
 def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
@@ -915,6 +969,8 @@ def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
         "pre-grasp": (lambda: arms.free, config.min_distance),
         "grasp": (lambda: arms.grasp, config.contact_min_distance),
         "lift": (lambda: arms.carry(key.X_GO), config.min_distance),
+        "pour": (lambda: arms.carry(key.X_GO), config.min_distance),
+        "tilted": (lambda: arms.carry(key.X_GO), config.min_distance),
         "pre-place": (lambda: arms.carry(key.X_GO), config.min_distance),
         "place": (lambda: arms.carry(key.X_GO), config.contact_min_distance),
         "retreat": (lambda: arms.placed(key.X_WO_place), config.contact_min_distance),
@@ -922,6 +978,8 @@ def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
     poses: dict[str, np.ndarray] = {}
     previous = None
     for name, (make_arm, min_distance) in steps.items():
+        if name not in key.X:
+            continue
         arm = make_arm()
         step_seeds = seeds if previous is None else [previous] + seeds
         r = solve_ik_seeds(arm, key.X[name], step_seeds,
@@ -938,6 +996,14 @@ def _line(key: _KeyPoses, a: str, b: str) -> StraightLine:
     return StraightLine(key.X[a].translation(), key.X[b].translation(), key.X[a].rotation())
 
 
+def _pour_moves(carry: ArmPlant, c: PlannerConfig) -> list[tuple]:
+    """The carrying moves of a pour: to the pour pose, tilt, tilt back, on to the pre-place."""
+    return [("carry", "lift", "pour", carry, c.min_distance, c.carry_limits, None),
+            ("tilt", "pour", "tilted", carry, c.min_distance, c.carry_limits, None),
+            ("untilt", "tilted", "pour", carry, c.min_distance, c.carry_limits, None),
+            ("return", "pour", "pre-place", carry, c.min_distance, c.carry_limits, None)]
+
+
 def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *, candidate,
                   part):
     """The segments between the key configurations, assembled into a Plan: (Plan, "", True) or
@@ -951,7 +1017,8 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
          _line(key, "pre-grasp", "grasp")),
         ("lift", "grasp", "lift", arms.grasp, c.contact_min_distance, c.contact_limits,
          _line(key, "grasp", "lift")),
-        ("carry", "lift", "pre-place", carry, c.min_distance, c.carry_limits, None),
+        *(_pour_moves(carry, c) if "pour" in key.X else
+          [("carry", "lift", "pre-place", carry, c.min_distance, c.carry_limits, None)]),
         ("descend", "pre-place", "place", carry, c.contact_min_distance, c.contact_limits,
          _line(key, "pre-place", "place")),
         ("retreat", "place", "retreat", arms.placed(key.X_WO_place), c.contact_min_distance,
@@ -992,6 +1059,13 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
     add_motion("lift")
     t_lift_done = t
     add_motion("carry")
+    t_pour = None
+    if "pour" in key.X:  # tilt over the bowl, hold, tilt back, on to the place
+        add_motion("tilt")
+        t_pour = (t, t + key.pour_hold)
+        add_hold(q["tilted"], key.pour_hold)
+        add_motion("untilt")
+        add_motion("return")
     add_motion("descend")
     t_open = t
     add_hold(q["place"], c.squeeze_duration + c.open_duration)
@@ -1008,5 +1082,5 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
                 t_place_done=t_place_done, duration=t, candidate=candidate, part=part,
                 X_WG_grasp=key.X["grasp"].GetAsMatrix4(),
                 X_WO_place=key.X_WO_place, waypoints=q, segments=tuple(rows),
-                R_turn=key.R_turn)
+                R_turn=key.R_turn, t_pour=t_pour)
     return plan, "", True

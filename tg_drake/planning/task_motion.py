@@ -14,6 +14,10 @@
   refused.
 - p&pOn: the object goes to the centre of the surface (`SurfaceConfig`), its box's lowest corner
   `release_height` above the surface's top; the surfaces are obstacles of every motion.
+- pourOut: carried upright over the bowl (`task.pour_into`, the perceived object nearest the
+  bowl's position), its opening's edge above the bowl's centre; tilted `pour_tilt` about a
+  horizontal axis through that edge (the horizontal part of the gripper's approach first: a turn
+  of the wrist, then its closing axis), held `pour_hold`, tilted back, then placed as usual.
 - every other task: the pick-and-place, the object's orientation kept.
 
 Each place pose is also turned about the vertical by `PlannerConfig.place_yaws`.
@@ -44,7 +48,9 @@ class TaskMotionConfig:
     # side grasp's approach points up, and the wrist stays clear of the table only higher up
     pour_tilt: float = 110.0  # [deg] pourOut: the container's axis turned this far from up
     pour_hold: float = 1.5  # [s] pourOut: held tilted over the bowl
-    pour_clearance: float = 0.04  # [m] pourOut: the container's lowest point above the bowl's
+    pour_clearance: float = 0.05  # [m] pourOut: the upright container's box above the bowl's
+    pour_yaws: list[float] = field(default_factory=lambda: [0.0, 90.0, -90.0, 180.0])  # [deg]
+    # pourOut: the pour turned about the bowl's vertical axis, tried in order
 
     def validate(self, where: str = "pipeline.tasks") -> None:
         checks = (("turned_release_heights", all(h >= 0.0 for h in self.turned_release_heights)
@@ -176,7 +182,12 @@ class TaskPlacing:
     place_xy: tuple
     support_z: float  # [m] world height of what the object is released onto
     surface: str = ""
-    turned_release_heights: tuple = (0.01,)  # [m] (TaskMotionConfig)  # the surface's name (p&pOn), else ""
+    turned_release_heights: tuple = (0.01,)  # [m] (TaskMotionConfig)
+    pour_at: tuple | None = None  # pourOut: world xy of the bowl's centre [m]; None: no pour
+    pour_tilt: float = np.deg2rad(110.0)  # [rad]
+    pour_hold: float = 1.5  # [s]
+    pour_clearance: float = 0.05  # [m]
+    pour_yaws: tuple = (0.0,)  # [rad]  # the surface's name (p&pOn), else ""
 
     def place_poses(self, X_WO: np.ndarray, X_WG: np.ndarray, extents, *, is_tool: bool,
                     release_height: float, place_pose) -> list[tuple]:
@@ -202,13 +213,74 @@ class TaskPlacing:
 
 
 def task_placing(task: str, *, place_xy, table_z: float, surface: Surface | None = None,
-                 config: TaskMotionConfig | None = None) -> TaskPlacing:
+                 pour_at=None, config: TaskMotionConfig | None = None) -> TaskPlacing:
     """The placing of `task` (module doc): the resting pose of p&pIn* (when `config.reorient`),
     the surface's centre and top for p&pOn (when the scenario has one), else the place target
-    on the table with the orientation kept."""
+    on the table with the orientation kept; pourOut pours over `pour_at` (world xy of the bowl)
+    first, when given."""
     config = config or TaskMotionConfig()
     pose = REST_POSE_OF_TASK.get(task) if config.reorient else None
     if task == "p&pOn" and surface is not None:
         return TaskPlacing(task, None, tuple(surface.xy), surface.top_z, surface.name)
+    pour = {}
+    if task == "pourOut" and pour_at is not None:
+        pour = dict(pour_at=(float(pour_at[0]), float(pour_at[1])),
+                    pour_tilt=float(np.deg2rad(config.pour_tilt)),
+                    pour_hold=float(config.pour_hold), pour_clearance=float(config.pour_clearance),
+                    pour_yaws=tuple(float(v) for v in np.deg2rad(config.pour_yaws)))
     return TaskPlacing(task, pose, tuple(float(v) for v in place_xy), float(table_z),
-                       turned_release_heights=tuple(config.turned_release_heights))
+                       turned_release_heights=tuple(config.turned_release_heights), **pour)
+
+
+def bowl_of(obstacles, pour_at) -> int | None:
+    """Index of the perceived object (`ObjectDescription`) nearest the bowl's xy `pour_at`."""
+    if not len(obstacles):
+        return None
+    d = [np.linalg.norm(np.asarray(o.X_WO)[:2, 3] - np.asarray(pour_at)) for o in obstacles]
+    return int(np.argmin(d))
+
+
+def box_top(X_WO: np.ndarray, extents) -> float:
+    """[m] world height of the highest corner of a box."""
+    corners = np.array(np.meshgrid(*[(-0.5, 0.5)] * 3)).reshape(3, -1).T * np.asarray(extents)
+    return float(np.max((np.asarray(X_WO)[:3, :3] @ corners.T)[2]) + np.asarray(X_WO)[2, 3])
+
+
+def pour_poses(X_WO: np.ndarray, extents, X_WG: np.ndarray, *, bowl_xy, bowl_top: float,
+               tilt: float, clearance: float, yaws=(0.0,)) -> list[tuple]:
+    """(X_WO_pour, X_WO_tilted) pairs for pouring a container (perceived frame X_WO, z towards
+    its opening; box `extents`) held by a gripper at X_WG into a bowl whose top is at
+    `bowl_top` over world xy `bowl_xy`: the upright container's opening edge above the bowl's
+    centre, its box `clearance` above the bowl's top; then turned by `tilt` [rad] about the
+    horizontal axis through that edge. Tilt axes: the horizontal parts of the gripper's approach
+    (a turn of the wrist) and closing axes, each way; each turned about the bowl's vertical by
+    `yaws` [rad]. [] when the container is not upright."""
+    X_WO = np.asarray(X_WO, float)
+    if perceived_pose(X_WO[:3, :3], is_tool=False) != "upright":
+        return []
+    h = float(extents[2])
+    r = 0.5 * max(float(extents[0]), float(extents[1]))
+    R_WG = np.asarray(X_WG, float)[:3, :3]
+    axes = []
+    for a in (_horizontal(R_WG[:, 1]), _horizontal(R_WG[:, 0])):
+        if a is not None:
+            axes += [a, -a]
+    z = X_WO[:3, 2]
+    lowest = -0.5 * abs(z @ UP) * h  # the box's bottom below its centre (upright, near level)
+    out = []
+    for yaw in yaws:
+        Rz = axis_angle(UP, yaw)
+        for a0 in axes:
+            a = Rz @ a0
+            d = np.cross(a, UP)  # where the opening leans as it turns
+            lip = np.array([bowl_xy[0], bowl_xy[1], bowl_top + clearance - lowest + h / 2])
+            centre = lip - h / 2 * z - r * d
+            X_pour = np.eye(4)
+            X_pour[:3, :3] = Rz @ X_WO[:3, :3]
+            X_pour[:3, 3] = centre
+            R = axis_angle(a, tilt)
+            X_tilted = np.eye(4)
+            X_tilted[:3, :3] = R @ X_pour[:3, :3]
+            X_tilted[:3, 3] = lip + R @ (centre - lip)
+            out.append((X_pour, X_tilted))
+    return out

@@ -50,7 +50,12 @@ from tg_drake.outcome import (
 )
 from tg_drake.scenario import SupervisorConfig
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
-from tg_drake.tasks.judge import REST_POSE_OF_TASK, judge_on_surface, judge_rest_pose
+from tg_drake.tasks.judge import (
+    REST_POSE_OF_TASK,
+    judge_on_surface,
+    judge_pour,
+    judge_rest_pose,
+)
 from tg_drake.tasks.outcome import TaskOutcome
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
@@ -181,10 +186,12 @@ class _Memory:
     requeries: int = 0
     failures: tuple = ()  # (part or None, reason) of every failed attempt, in order
     status: PlanStatus | None = None  # the planner's answer with the plan being executed
-    checks_passed: int = 0  # execution checks passed: 1 grasp closed, 2 lift done
+    checks_passed: int = 0  # execution checks passed: 1 grasp closed, 2 lift done, 3 the pour
+    # held over the bowl (pourOut plans only)
     z_G_grasped: float = 0.0  # [m] gripper body height when the grasp closed
     z_O_grasped: float = 0.0  # [m] object height when the grasp closed
     X_WO_picked: RigidTransform | None = None  # object pose when the plan started
+    held_at_pour: bool = False  # the gripper held the container at the end of the pour
     outcome: Outcome | None = None  # the final outcome
 
     def __deepcopy__(self, memo):
@@ -225,14 +232,20 @@ class Supervisor(LeafSystem):
     """
 
     def __init__(self, *, config: SupervisorConfig | None = None, model: "MonitorModel",
-                 task: str = "", place_on: str = ""):
+                 task: str = "", place_on: str = "", pour_into: str = "", container: str = "",
+                 count_contents=None):
         """`task`: the scenario's given task ("" = inferred: no task check); `place_on`: the
-        surface p&pOn places the object on."""
+        surface p&pOn places the object on; `pour_into`: the instance name of the bowl
+        (pourOut); `container`: the target's instance name (pourIn's receiving vessel);
+        `count_contents`: body_poses → {place: number of spheres} (the keys of
+        `tg_drake.tasks.contents.count_contents`), None when the station has no contents."""
         super().__init__()
         self._config = config or SupervisorConfig()
         self._config.validate()
         self._model = model
         self._task, self._place_on = task, place_on
+        self._pour_into, self._container = pour_into, container
+        self._count_contents = count_contents
 
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
@@ -396,7 +409,9 @@ class Supervisor(LeafSystem):
     def _monitor(self, context, memory: _Memory) -> _Memory:
         plan, t_plan = memory.status.plan, memory.status.t_plan
         t = context.get_time() - t_plan
-        key_time = (plan.t_grasp_closed, plan.t_lift_done, plan.duration)[memory.checks_passed]
+        pour = () if plan.t_pour is None else (plan.t_pour[1],)
+        key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, plan.duration)
+        key_time = key_times[memory.checks_passed]
         if t < key_time:
             return memory
         contacts = self._contacts_port.Eval(context)
@@ -421,6 +436,8 @@ class Supervisor(LeafSystem):
                                     f"the object rose {rise * 100:.1f} cm while the gripper rose "
                                     f"{gripper_rise * 100:.1f} cm")
             return dataclasses.replace(memory, checks_passed=2)
+        if memory.checks_passed == 2 and pour:  # the pour's hold is over
+            return dataclasses.replace(memory, checks_passed=3, held_at_pour=hand.held)
         # The plan is over: let go, the table carries the object (a pad may still brush it).
         if not np.all(np.isfinite(X_WO.GetAsMatrix4())):
             return self._finish(memory, Status.failed, Reason.simulation,
@@ -433,13 +450,14 @@ class Supervisor(LeafSystem):
                 memory.X_WO_picked.translation())
         ok, detail = placed(X_WO_expected, X_WO, plan.X_WO_place[:2, 3],
                             released=on_table and not hand.held, p_OC=self._model.p_OC)
-        task = self._task_check(X_WO, plan, contacts, released=not hand.held)
+        task = self._task_check(X_WO, plan, contacts, released=not hand.held, poses=poses,
+                                held_at_pour=memory.held_at_pour)
         if ok:
             return self._finish(memory, Status.placed, Reason.none, detail, task)
         return self._finish(memory, Status.lifted, Reason.slipped, detail, task)
 
-    def _task_check(self, X_WO: RigidTransform, plan, contacts, *, released: bool
-                    ) -> TaskOutcome | None:
+    def _task_check(self, X_WO: RigidTransform, plan, contacts, *, released: bool, poses=(),
+                    held_at_pour: bool = False) -> TaskOutcome | None:
         """The given task's judgement at the end of the plan (None when no task is given)."""
         task, model = self._task, self._model
         if not task:
@@ -459,6 +477,17 @@ class Supervisor(LeafSystem):
                   for name, ids in (("surface", surfaces[self._place_on]), ("table", table_top))}
             return judge_on_surface(self._place_on, on_surface=on["surface"],
                                     on_table=on["table"], released=released)
+        if task in ("pourOut", "pourIn"):
+            poured = plan.t_pour is not None
+            if self._count_contents is None:
+                what = ("tilted over the bowl" if poured else
+                        "placed as for pick-and-place (no bowl: task.pour_into)")
+                return TaskOutcome(task, False, {"poured": poured},
+                                   f"{what}; the station has no contents to count "
+                                   "(`contents: {model: spheres}`)")
+            counts = self._count_contents(poses)
+            into = self._pour_into if task == "pourOut" else self._container
+            return judge_pour(task, counts, into=into, held=held_at_pour)
         return TaskOutcome(task, False, {}, f"the {task} motion and check are not implemented "
                            "yet: the object was placed as for pick-and-place")
 
