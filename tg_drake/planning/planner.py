@@ -52,6 +52,7 @@ from tg_drake.planning.task_motion import (
     TaskPlacing,
     bowl_of,
     box_top,
+    fill_poses,
     pour_poses,
     turned_retreat,
 )
@@ -191,7 +192,7 @@ class Plan:
     R_turn: np.ndarray | None = None  # 3×3 world-frame rotation the plan gives the object
     # beyond a turn about the vertical (a task's resting pose); None: its orientation is kept
     t_pour: tuple | None = None  # [s] (start, end) of holding the container tilted over the
-    # bowl (pourOut); None when the plan pours nothing
+    # bowl (pourOut) or under the dispenser (pourIn); None when the plan pours nothing
 
     def q(self, t: float) -> np.ndarray:
         """(7,) joint positions at plan time t (held at the ends outside [0, duration])."""
@@ -364,7 +365,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 if k_pour in failed_pours:
                     continue
                 key = _key_poses(arms, X_WG, X_WO, X_WO_place_yawed, config, R_turn=R_turn,
-                                 pour=pour, pour_hold=placing.pour_hold if pour else 0.0)
+                                 pour=pour, pour_hold=placing.hold if pour else 0.0)
                 below = [n for n in ("pre-grasp", "grasp")
                          if key.X[n].translation()[2] < table_z]
                 if below:  # the WSG body's origin under the table top: no need to ask the IK
@@ -472,6 +473,10 @@ def _pours(placing: TaskPlacing | None, obstacles, target: ObjectDescription,
            X_WG: np.ndarray) -> tuple[list, str]:
     """The pours to try for grasp X_WG (`task_motion.pour_poses`: (X_WO_pour, X_WO_tilted)),
     [None] when the task pours nothing; ([], why) when it cannot pour."""
+    if placing is not None and placing.fill_at is not None:
+        fills = fill_poses(np.asarray(target.X_WO, float), target.extents, gate=placing.fill_at,
+                           clearance=placing.fill_clearance, yaws=placing.pour_yaws)
+        return (fills, "") if fills else ([], f"pour pose: {target_name(target)} is not upright")
     if placing is None or placing.pour_at is None:
         return [None], ""
     k = bowl_of(obstacles, placing.pour_at)
@@ -952,10 +957,10 @@ def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config, *, R_turn=None, pour
         X_WO_pour, X_WO_tilted = pour
         order = list(X)
         at = order.index("lift") + 1
-        poses = dict(pour=RigidTransform(X_WO_pour) @ X_OG,
-                     tilted=RigidTransform(X_WO_tilted) @ X_OG)
-        X = {n: (X[n] if n in X else poses[n])
-             for n in order[:at] + ["pour", "tilted"] + order[at:]}
+        poses = dict(pour=RigidTransform(X_WO_pour) @ X_OG)
+        if X_WO_tilted is not None:  # pourIn holds it upright: no tilt
+            poses["tilted"] = RigidTransform(X_WO_tilted) @ X_OG
+        X = {n: (X[n] if n in X else poses[n]) for n in order[:at] + list(poses) + order[at:]}
     return _KeyPoses(X, X_OG.inverse(), np.asarray(X_WO_place, float), R_turn, pour_hold)
 
 
@@ -996,12 +1001,14 @@ def _line(key: _KeyPoses, a: str, b: str) -> StraightLine:
     return StraightLine(key.X[a].translation(), key.X[b].translation(), key.X[a].rotation())
 
 
-def _pour_moves(carry: ArmPlant, c: PlannerConfig) -> list[tuple]:
-    """The carrying moves of a pour: to the pour pose, tilt, tilt back, on to the pre-place."""
-    return [("carry", "lift", "pour", carry, c.min_distance, c.carry_limits, None),
-            ("tilt", "pour", "tilted", carry, c.min_distance, c.carry_limits, None),
-            ("untilt", "tilted", "pour", carry, c.min_distance, c.carry_limits, None),
-            ("return", "pour", "pre-place", carry, c.min_distance, c.carry_limits, None)]
+def _pour_moves(carry: ArmPlant, c: PlannerConfig, *, tilt: bool) -> list[tuple]:
+    """The carrying moves of a pour: to the pour pose, tilt and tilt back (pourOut), on to the
+    pre-place."""
+    tilts = [("tilt", "pour", "tilted", carry, c.min_distance, c.carry_limits, None),
+             ("untilt", "tilted", "pour", carry, c.min_distance, c.carry_limits, None)]
+    return ([("carry", "lift", "pour", carry, c.min_distance, c.carry_limits, None)]
+            + (tilts if tilt else [])
+            + [("return", "pour", "pre-place", carry, c.min_distance, c.carry_limits, None)])
 
 
 def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *, candidate,
@@ -1017,7 +1024,7 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
          _line(key, "pre-grasp", "grasp")),
         ("lift", "grasp", "lift", arms.grasp, c.contact_min_distance, c.contact_limits,
          _line(key, "grasp", "lift")),
-        *(_pour_moves(carry, c) if "pour" in key.X else
+        *(_pour_moves(carry, c, tilt="tilted" in key.X) if "pour" in key.X else
           [("carry", "lift", "pre-place", carry, c.min_distance, c.carry_limits, None)]),
         ("descend", "pre-place", "place", carry, c.contact_min_distance, c.contact_limits,
          _line(key, "pre-place", "place")),
@@ -1060,11 +1067,15 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
     t_lift_done = t
     add_motion("carry")
     t_pour = None
-    if "pour" in key.X:  # tilt over the bowl, hold, tilt back, on to the place
+    if "tilted" in key.X:  # tilt over the bowl, hold, tilt back, on to the place
         add_motion("tilt")
         t_pour = (t, t + key.pour_hold)
         add_hold(q["tilted"], key.pour_hold)
         add_motion("untilt")
+        add_motion("return")
+    elif "pour" in key.X:  # held under the dispenser, on to the place
+        t_pour = (t, t + key.pour_hold)
+        add_hold(q["pour"], key.pour_hold)
         add_motion("return")
     add_motion("descend")
     t_open = t

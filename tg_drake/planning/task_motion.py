@@ -18,6 +18,9 @@
   bowl's position), its opening's edge above the bowl's centre; tilted `pour_tilt` about a
   horizontal axis through that edge (the horizontal part of the gripper's approach first: a turn
   of the wrist, then its closing axis), held `pour_hold`, tilted back, then placed as usual.
+- pourIn: carried upright under the dispenser (`fill_at`), its box `fill_clearance` under the
+  hopper's gate; held there `fill_open` with the dispenser open (the supervisor's
+  ``dispenser_command``) and `fill_settle` more, then placed as usual.
 - every other task: the pick-and-place, the object's orientation kept.
 
 Each place pose is also turned about the vertical by `PlannerConfig.place_yaws`.
@@ -50,14 +53,21 @@ class TaskMotionConfig:
     pour_hold: float = 1.5  # [s] pourOut: held tilted over the bowl
     pour_clearance: float = 0.05  # [m] pourOut: the upright container's box above the bowl's
     pour_yaws: list[float] = field(default_factory=lambda: [0.0, 90.0, -90.0, 180.0])  # [deg]
-    # pourOut: the pour turned about the bowl's vertical axis, tried in order
+    # pourOut: the pour turned about the bowl's vertical axis, tried in order; pourIn: the
+    # container turned about the dispenser's vertical axis
+    fill_clearance: float = 0.02  # [m] pourIn: the container's box under the dispenser's gate
+    fill_open: float = 1.5  # [s] pourIn: the dispenser is open while the container is held
+    fill_settle: float = 1.0  # [s] pourIn: held on after the dispenser closes
 
     def validate(self, where: str = "pipeline.tasks") -> None:
         checks = (("turned_release_heights", all(h >= 0.0 for h in self.turned_release_heights)
                    and len(self.turned_release_heights) > 0, "a non-empty list of heights >= 0 m"),
                   ("pour_tilt", 0.0 < self.pour_tilt <= 180.0, "in (0, 180] deg"),
                   ("pour_hold", self.pour_hold >= 0.0, ">= 0 s"),
-                  ("pour_clearance", self.pour_clearance >= 0.0, ">= 0 m"))
+                  ("pour_clearance", self.pour_clearance >= 0.0, ">= 0 m"),
+                  ("fill_clearance", self.fill_clearance >= 0.0, ">= 0 m"),
+                  ("fill_open", self.fill_open > 0.0, "> 0 s"),
+                  ("fill_settle", self.fill_settle >= 0.0, ">= 0 s"))
         for name, ok, allowed in checks:
             if not ok:
                 raise ScenarioError(f"must be {allowed}, got {getattr(self, name)}",
@@ -187,7 +197,17 @@ class TaskPlacing:
     pour_tilt: float = np.deg2rad(110.0)  # [rad]
     pour_hold: float = 1.5  # [s]
     pour_clearance: float = 0.05  # [m]
-    pour_yaws: tuple = (0.0,)  # [rad]  # the surface's name (p&pOn), else ""
+    pour_yaws: tuple = (0.0,)  # [rad]
+    fill_at: tuple | None = None  # pourIn: world (x, y, z) of the dispenser's gate [m]; None:
+    # no fill
+    fill_clearance: float = 0.02  # [m]
+    fill_open: float = 1.5  # [s]
+    fill_settle: float = 1.0  # [s]
+
+    @property
+    def hold(self) -> float:
+        """[s] how long the container is held at the pour (tilted) or under the dispenser."""
+        return self.fill_open + self.fill_settle if self.fill_at is not None else self.pour_hold  # the surface's name (p&pOn), else ""
 
     def place_poses(self, X_WO: np.ndarray, X_WG: np.ndarray, extents, *, is_tool: bool,
                     release_height: float, place_pose) -> list[tuple]:
@@ -213,11 +233,12 @@ class TaskPlacing:
 
 
 def task_placing(task: str, *, place_xy, table_z: float, surface: Surface | None = None,
-                 pour_at=None, config: TaskMotionConfig | None = None) -> TaskPlacing:
+                 pour_at=None, fill_at=None,
+                 config: TaskMotionConfig | None = None) -> TaskPlacing:
     """The placing of `task` (module doc): the resting pose of p&pIn* (when `config.reorient`),
     the surface's centre and top for p&pOn (when the scenario has one), else the place target
     on the table with the orientation kept; pourOut pours over `pour_at` (world xy of the bowl)
-    first, when given."""
+    first, when given; pourIn is filled under `fill_at` (world xyz of the dispenser's gate)."""
     config = config or TaskMotionConfig()
     pose = REST_POSE_OF_TASK.get(task) if config.reorient else None
     if task == "p&pOn" and surface is not None:
@@ -227,6 +248,11 @@ def task_placing(task: str, *, place_xy, table_z: float, surface: Surface | None
         pour = dict(pour_at=(float(pour_at[0]), float(pour_at[1])),
                     pour_tilt=float(np.deg2rad(config.pour_tilt)),
                     pour_hold=float(config.pour_hold), pour_clearance=float(config.pour_clearance),
+                    pour_yaws=tuple(float(v) for v in np.deg2rad(config.pour_yaws)))
+    if task == "pourIn" and fill_at is not None:
+        pour = dict(fill_at=tuple(float(v) for v in fill_at),
+                    fill_clearance=float(config.fill_clearance),
+                    fill_open=float(config.fill_open), fill_settle=float(config.fill_settle),
                     pour_yaws=tuple(float(v) for v in np.deg2rad(config.pour_yaws)))
     return TaskPlacing(task, pose, tuple(float(v) for v in place_xy), float(table_z),
                        turned_release_heights=tuple(config.turned_release_heights), **pour)
@@ -283,4 +309,22 @@ def pour_poses(X_WO: np.ndarray, extents, X_WG: np.ndarray, *, bowl_xy, bowl_top
             X_tilted[:3, :3] = R @ X_pour[:3, :3]
             X_tilted[:3, 3] = lip + R @ (centre - lip)
             out.append((X_pour, X_tilted))
+    return out
+
+
+def fill_poses(X_WO: np.ndarray, extents, *, gate: tuple, clearance: float,
+               yaws=(0.0,)) -> list[tuple]:
+    """(X_WO_fill, None) for holding an upright container (perceived frame X_WO, box `extents`)
+    under a dispenser's gate at world `gate` (x, y, z): its box centred under the gate, its top
+    `clearance` below it, turned about the vertical by `yaws` [rad]; [] when not upright."""
+    X_WO = np.asarray(X_WO, float)
+    if perceived_pose(X_WO[:3, :3], is_tool=False) != "upright":
+        return []
+    top = 0.5 * abs(X_WO[:3, 2] @ UP) * float(extents[2])  # the box's top above its centre
+    out = []
+    for yaw in yaws:
+        X = np.eye(4)
+        X[:3, :3] = axis_angle(UP, yaw) @ X_WO[:3, :3]
+        X[:3, 3] = [gate[0], gate[1], gate[2] - clearance - top]
+        out.append((X, None))
     return out

@@ -216,6 +216,7 @@ class Supervisor(LeafSystem):
         - collisions
         - plan_request
         - outcome
+        - dispenser_command
 
     ``scene_description`` (`SceneDescription`), ``grasp_semantics`` (`GraspSemantics`) and
     ``ranked_grasps`` (`GraspCandidates`) are read at gate checks only; ``plan_status``
@@ -228,17 +229,20 @@ class Supervisor(LeafSystem):
 
     Outputs depend on the state only: ``collisions`` (tuple of part names, for the logic's
     ``collisions`` input), ``plan_request`` (`PlanRequest`: the attempt to plan and the parts to
-    leave out, for the planner) and ``outcome`` (`Outcome`; `Outcome.final` once decided).
+    leave out, for the planner) and ``outcome`` (`Outcome`; `Outcome.final` once decided);
+    ``dispenser_command`` (1-vector: 1 opens the station's dispenser) on the state and the time.
     """
 
     def __init__(self, *, config: SupervisorConfig | None = None, model: "MonitorModel",
                  task: str = "", place_on: str = "", pour_into: str = "", container: str = "",
-                 count_contents=None):
+                 count_contents=None, dispense_duration: float = 0.0):
         """`task`: the scenario's given task ("" = inferred: no task check); `place_on`: the
         surface p&pOn places the object on; `pour_into`: the instance name of the bowl
         (pourOut); `container`: the target's instance name (pourIn's receiving vessel);
         `count_contents`: body_poses → {place: number of spheres} (the keys of
-        `tg_drake.tasks.contents.count_contents`), None when the station has no contents."""
+        `tg_drake.tasks.contents.count_contents`), None when the station has no contents;
+        `dispense_duration` [s]: pourIn opens the dispenser (``dispenser_command`` 1) this long
+        from the start of the plan's hold under it."""
         super().__init__()
         self._config = config or SupervisorConfig()
         self._config.validate()
@@ -246,6 +250,7 @@ class Supervisor(LeafSystem):
         self._task, self._place_on = task, place_on
         self._pour_into, self._container = pour_into, container
         self._count_contents = count_contents
+        self._dispense_duration = float(dispense_duration)
 
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
@@ -277,6 +282,9 @@ class Supervisor(LeafSystem):
         self._outcome_port = self.DeclareAbstractOutputPort(
             "outcome", lambda: AbstractValue.Make(Outcome()), self._calc_outcome,
             prerequisites_of_calc=on_state)
+        self._dispenser_port = self.DeclareVectorOutputPort(
+            "dispenser_command", 1, self._calc_dispenser,
+            prerequisites_of_calc=on_state | {self.time_ticket()})
 
     @property
     def config(self) -> SupervisorConfig:
@@ -312,6 +320,9 @@ class Supervisor(LeafSystem):
 
     def get_outcome_output_port(self):
         return self._outcome_port
+
+    def get_dispenser_command_output_port(self):
+        return self._dispenser_port
 
     # The periodic check.
     def _check(self, context, state):
@@ -501,6 +512,17 @@ class Supervisor(LeafSystem):
     def _calc_request(self, context, output):
         memory = self._memory_of(context)
         output.set_value(PlanRequest(attempt=memory.attempt, exclude_parts=memory.collisions))
+
+    def _calc_dispenser(self, context, output):
+        """1 while a pourIn plan holds the container under the dispenser (its first
+        `dispense_duration` seconds), else 0."""
+        memory = self._memory_of(context)
+        plan = memory.status.plan if memory.status is not None else None
+        open_ = False
+        if self._task == "pourIn" and plan is not None and plan.t_pour is not None:
+            t = context.get_time() - memory.status.t_plan
+            open_ = plan.t_pour[0] <= t < plan.t_pour[0] + self._dispense_duration
+        output.SetAtIndex(0, 1.0 if open_ else 0.0)
 
     def _calc_outcome(self, context, output):
         memory = self._memory_of(context)
