@@ -38,9 +38,9 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.grasping.model import load_model
 from tg_drake.objects import box_centre, get_object
-from tg_drake.planning.task_motion import surfaces_in_world, task_placing
+from tg_drake.planning.task_motion import dispenser_obstacle, surfaces_in_world, task_placing
 from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario, place_surface
-from tg_drake.station import Station, add_station, placement_pose
+from tg_drake.station import DISPENSER_WALL, Station, add_station, dispenser_frame, placement_pose
 from tg_drake.systems.dgi_system import DgiScoringSystem
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.kernel_prior_system import KernelPriorSystem
@@ -48,6 +48,8 @@ from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
 from tg_drake.systems.perception_system import GroundTruthPerception, PerceptionSystem
 from tg_drake.systems.supervisor import MonitorModel, Supervisor
 from tg_drake.table import surface_body_name
+from tg_drake.tasks.contents import hopper_height
+from tg_drake.tasks.judge import contents_counter
 from tg_drake.targeting import select_target
 from tg_drake.types import SceneDescription
 
@@ -91,6 +93,25 @@ class Pipeline:
     task: LeafSystem
     config: PipelineConfig
     ports: dict = field(default_factory=dict)  # stage output ports by name
+
+
+def _contents_counter(scenario: Scenario, station: Station, target_placement):
+    """The supervisor's contents counter of the task (`tg_drake.tasks.judge.contents_counter`):
+    pourOut counts the target's spheres in the target and the bowl, pourIn the dispenser's in
+    the target; None when the station has no such spheres."""
+    task = scenario.task.task
+    source = {"pourOut": target_placement.instance_name, "pourIn": "dispenser"}.get(task)
+    model = next((m for m in station.contents if m.name == source), None)
+    if model is None:
+        return None
+    names = [target_placement.instance_name]
+    if task == "pourOut" and scenario.task.pour_into:
+        names.append(scenario.task.pour_into)
+    placements = {p.instance_name: p for p in scenario.objects}
+    containers = {n: (int(station.object_body(n).index()), get_object(placements[n].id))
+                  for n in names}
+    return contents_counter(model, containers=containers,
+                            table_z=float(scenario.X_WT.GetDeterministicValue().translation()[2]))
 
 
 def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
@@ -160,8 +181,16 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     for placement in scenario.objects:
         if scenario.task.pour_into and placement.instance_name == scenario.task.pour_into:
             pour_at = placement_pose(scenario, placement).multiply(box_centre(placement.id))[:2]
+    fill_at = None  # pourIn: under the dispenser's gate; its hopper is an obstacle
+    if scenario.dispenser is not None:
+        X_WH = dispenser_frame(scenario).GetAsMatrix4()
+        d = scenario.dispenser
+        fill_at = X_WH[:3, 3] - X_WH[:3, 2] * DISPENSER_WALL  # the gate's underside
+        surfaces.append(dispenser_obstacle(
+            X_WH, side=d.width + 2 * DISPENSER_WALL, below=DISPENSER_WALL,
+            above=hopper_height(d, d.sphere_radius(scenario.contents)) + DISPENSER_WALL))
     placing = task_placing(scenario.task.task, place_xy=place_xy_W, pour_at=pour_at,
-                           table_z=float(X_WT.translation()[2]),
+                           fill_at=fill_at, table_z=float(X_WT.translation()[2]),
                            surface=next((s for s in surfaces if surface is not None
                                          and s.name == surface.name), None),
                            config=config.tasks)
@@ -184,7 +213,12 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
             is_tool=get_object(target_placement.id).is_tool,
             surfaces=[(s.name, surface_body_name(s.name)) for s in scenario.surfaces]),
         task=scenario.task.task, place_on=surface.name if surface is not None else "",
-        pour_into=scenario.task.pour_into, container=target_placement.instance_name))
+        pour_into=scenario.task.pour_into, container=target_placement.instance_name,
+        count_contents=_contents_counter(scenario, station, target_placement),
+        dispense_duration=config.tasks.fill_open))
+    if "dispenser.open" in station.inputs:
+        builder.Connect(supervisor.GetOutputPort("dispenser_command"),
+                        station.inputs["dispenser.open"])
     builder.Connect(scene, supervisor.GetInputPort("scene_description"))
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     supervisor.GetInputPort("grasp_semantics"))

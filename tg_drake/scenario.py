@@ -46,6 +46,7 @@ from tg_drake.robot import WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
 from tg_drake.robot_plants import default_directives
 from tg_drake.schema_check import SchemaError, check_document, load_raw
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, table_size_problem
+from tg_drake.tasks.contents import ContentsConfig, DispenserConfig, container_sites
 from tg_drake.types import CATEGORIES, CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 # The WSG body frame G on the iiwa's link 7 (tg_drake.robot: the mount).
@@ -370,6 +371,10 @@ class Scenario:
     # builds the table from these (tg_drake.table); objects must stand within the top.
     table_size: list[float] = field(default_factory=lambda: list(TABLE_SIZE))
     X_WT: Transform = field(default_factory=lambda: _transform(X_WT_DEFAULT))
+    # Contents of full containers ("mass" or "spheres") and an optional dispenser of spheres
+    # (pourIn); tg_drake.tasks.contents.
+    contents: ContentsConfig = field(default_factory=ContentsConfig)
+    dispenser: DispenserConfig | None = None
 
     def target_placement(self) -> ObjectPlacement:
         if not self.objects:
@@ -559,6 +564,7 @@ def validate(scenario: Scenario, *, where: str = "<scenario>",
         _validate_simulation(scenario)
         _validate_geometry(scenario)
         _validate_surfaces(scenario)
+        _validate_contents(scenario)
     except ScenarioError as e:
         raise ScenarioError(e.message, file=where, field=e.field) from None
 
@@ -886,3 +892,21 @@ def _validate_surfaces(scenario: Scenario) -> None:
         if scenario.objects and into == scenario.target_placement().instance_name:
             raise ScenarioError("the object poured into is the target itself",
                                 field="task.pour_into")
+def _validate_contents(scenario: Scenario) -> None:
+    """The contents block, the dispenser, and (spheres) that each full container's cavity holds
+    its spheres."""
+    scenario.contents.validate()
+    if scenario.dispenser is not None:
+        scenario.dispenser.validate(scenario.table_size, scenario.contents)
+    if scenario.contents.model != "spheres":
+        return
+    for i, placement in enumerate(scenario.objects):
+        if placement.containment != "full":
+            continue
+        obj = get_object(placement.id)
+        V, F = mesh(obj)[:2]
+        try:
+            container_sites(obj.id, V, F, scenario.contents)
+        except ScenarioError as e:
+            field = e.field if e.field == "contents.count" else f"objects[{i}].containment"
+            raise ScenarioError(e.message, field=field) from None

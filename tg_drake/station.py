@@ -17,9 +17,15 @@ before the station is built). No images are published. A sensor renders only whe
 ports is evaluated, so a stage that needs one image asks once, and the simulation itself never
 renders.
 
+A full container's contents are, by `contents.model`, the water's mass welded inside it ("mass")
+or free compliant-hydroelastic spheres packed in its cavity ("spheres", `Station.contents`); a
+`dispenser` adds a hopper of spheres above the table with a sliding gate (tg_drake.tasks.contents).
+The spheres and the dispenser are drawn in Meshcat but not seen by the cameras.
+
 Station ports (as exported by `make_station`; `add_station` returns the same ports by name):
 
-- inputs: ``iiwa.desired_state`` (14: q, v), ``wsg.position`` (1: opening width [m]).
+- inputs: ``iiwa.desired_state`` (14: q, v), ``wsg.position`` (1: opening width [m]), and with a
+  `dispenser` ``dispenser.open`` (1: > 0.5 opens its gate).
 - outputs: ``iiwa.state`` (14), ``wsg.state`` (4), ``body_poses``, ``contact_results``,
   ``query_object``, and per camera ``<camera>.rgb_image``, ``<camera>.depth_image``,
   ``<camera>.label_image``, ``<camera>.camera_pose`` (X_WC, a RigidTransform).
@@ -34,9 +40,18 @@ from dataclasses import dataclass, field
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.geometry import (
+    AddCompliantHydroelasticProperties,
+    AddContactMaterial,
+    AddRigidHydroelasticProperties,
+    Box,
+    GeometryInstance,
+    MakePhongIllustrationProperties,
     MakeRenderEngineGl,
+    PerceptionProperties,
+    ProximityProperties,
     RenderEngineGlParams,
     SceneGraph,
+    Sphere,
     kHasRenderEngineGl,
 )
 from pydrake.lcm import DrakeLcm
@@ -48,11 +63,12 @@ from pydrake.multibody.parsing import (
     Parser,
     ProcessModelDirectives,
 )
-from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import (
     JointActuatorIndex,
     ModelInstanceIndex,
     PdControllerGains,
+    PrismaticJoint,
     SpatialInertia,
     UnitInertia,
 )
@@ -63,7 +79,7 @@ from pydrake.systems.sensors import ApplyCameraConfig, CameraConfig, CameraInfo,
 
 from tg_drake.errors import ModelError, ScenarioError, unknown_name
 from tg_drake.models import make_parser
-from tg_drake.objects import get_object
+from tg_drake.objects import get_object, mesh
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
 from tg_drake.robot_plants import add_scenario_models
 from tg_drake.scenario import (
@@ -75,6 +91,14 @@ from tg_drake.scenario import (
     resolve_objects,
 )
 from tg_drake.table import add_surfaces, add_table
+from tg_drake.tasks.contents import (
+    ContentsConfig,
+    ContentsModel,
+    DispenserConfig,
+    container_sites,
+    hopper_height,
+    hopper_sites,
+)
 
 WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container
 NO_LCM = "memq://null"  # the LCM URL that publishes nothing: the station sends no messages
@@ -111,6 +135,8 @@ class Station:
     cameras: dict[str, CameraHandles]
     inputs: dict = field(default_factory=dict)  # port name → InputPort
     outputs: dict = field(default_factory=dict)  # port name → OutputPort
+    # The spheres of each full container (contents.model: spheres) and of the dispenser.
+    contents: list[ContentsModel] = field(default_factory=list)
 
     def object_body(self, name: str):
         bodies = self.plant.GetBodyIndices(self.objects[name])
@@ -150,8 +176,8 @@ def _apply_joint_pd(plant: MultibodyPlant, instance: ModelInstanceIndex, kp: flo
         actuator.set_controller_gains(PdControllerGains(p=kp, d=kd))
 
 
-def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser
-                 ) -> dict[str, ModelInstanceIndex]:
+def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser,
+                 contents: list[ContentsModel]) -> dict[str, ModelInstanceIndex]:
     if not scenario.objects:
         return {}
     # User libraries and mesh entries (a validated scenario's paths are absolute; the import is
@@ -166,7 +192,11 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser
         objects[placement.instance_name] = instance
         body = plant.get_body(plant.GetBodyIndices(instance)[0])
         plant.SetDefaultFloatingBaseBodyPose(body, placement_pose(scenario, placement))
-        if placement.containment == "full":
+        if placement.containment == "full" and scenario.contents.model == "spheres":
+            contents.append(_add_sphere_contents(plant, placement, get_object(placement.id),
+                                                 placement_pose(scenario, placement),
+                                                 scenario.contents))
+        elif placement.containment == "full":
             _add_contents(plant, instance, body, get_object(placement.id))
     return objects
 
@@ -192,6 +222,134 @@ def _add_contents(plant: MultibodyPlant, instance, body, obj) -> None:
     plant.WeldFrames(body.body_frame(), contents.body_frame(), RigidTransform(p_OC))
 
 
+SPHERE_COLOR = (0.2, 0.45, 0.9, 1.0)  # RGBA of the contents' spheres (Meshcat)
+DISPENSER_COLOR = (0.6, 0.6, 0.65, 0.5)  # RGBA of the hopper and its gate
+DISPENSER_WALL = 0.004  # [m] thickness of the hopper's walls and gate
+GATE_GAP = 0.001  # [m] between the walls' bottom and the gate's top, so the gate slides free
+GATE_MASS = 0.2  # [kg]
+GATE_KP = 400.0  # [N/m] PD gains of the gate's slide (it opens by one width in ~0.3 s)
+GATE_KD = 40.0  # [N·s/m]
+GATE_FORCE = 50.0  # [N] effort limit of the gate's actuator
+
+
+def _illustration_only(shape, name: str, X_BG: RigidTransform, rgba, visible: bool
+                       ) -> GeometryInstance:
+    """Visual geometry for Meshcat; the cameras see it only when `visible`."""
+    instance = GeometryInstance(X_BG, shape, name)
+    instance.set_illustration_properties(MakePhongIllustrationProperties(np.asarray(rgba)))
+    if visible:
+        perception = PerceptionProperties()
+        perception.AddProperty("phong", "diffuse", np.asarray(rgba))
+        instance.set_perception_properties(perception)
+    return instance
+
+
+def add_spheres(plant: MultibodyPlant, instance: ModelInstanceIndex, prefix: str,
+                p_W: np.ndarray, radius: float, mass: float, config: ContentsConfig,
+                visible: bool = False) -> tuple[int, ...]:
+    """Free compliant-hydroelastic spheres of `radius` [m] and `mass` [kg] each at the world
+    positions p_W (n, 3), before Finalize; returns their body indices."""
+    proximity = ProximityProperties()
+    AddContactMaterial(dissipation=config.dissipation,
+                       friction=CoulombFriction(config.friction, config.friction),
+                       properties=proximity)
+    AddCompliantHydroelasticProperties(config.resolution_hint, config.modulus, proximity)
+    M = SpatialInertia.SolidSphereWithMass(mass, radius)
+    bodies = []
+    for k, p in enumerate(np.asarray(p_W, float)):
+        body = plant.AddRigidBody(f"{prefix}_{k}", instance, M)
+        plant.RegisterCollisionGeometry(body, RigidTransform(), Sphere(radius), "collision",
+                                        proximity)
+        plant.RegisterVisualGeometry(body, _illustration_only(
+            Sphere(radius), f"{prefix}_{k}_visual", RigidTransform(), SPHERE_COLOR, visible))
+        plant.SetDefaultFloatingBaseBodyPose(body, RigidTransform(p))
+        bodies.append(int(body.index()))
+    return tuple(bodies)
+
+
+def _add_sphere_contents(plant: MultibodyPlant, placement: ObjectPlacement, obj,
+                         X_WO: RigidTransform, config: ContentsConfig) -> ContentsModel:
+    """A "full" container's water as free spheres packed in its cavity, of the water's total
+    mass (WATER_DENSITY × cavity volume), in a model instance `<name>_contents`."""
+    V, F = mesh(obj)[:2]
+    p_O = container_sites(obj.id, V, F, config)
+    name = placement.instance_name
+    instance = plant.AddModelInstance(f"{name}_contents")
+    mass = WATER_DENSITY * obj.cavity_volume / len(p_O)
+    p_W = p_O @ X_WO.rotation().matrix().T + X_WO.translation()
+    bodies = add_spheres(plant, instance, f"{name}_sphere", p_W, config.radius, mass, config)
+    return ContentsModel(name=name, bodies=bodies, radius=config.radius)
+
+
+def dispenser_frame(scenario: Scenario) -> RigidTransform:
+    """X_WH: the hopper frame H, at the centre of the gate's top, axes of the table frame."""
+    d = scenario.dispenser
+    return scenario.X_WT.GetDeterministicValue() @ RigidTransform([d.xy[0], d.xy[1], d.height])
+
+
+def _add_dispenser(plant: MultibodyPlant, scenario: Scenario) -> tuple[ContentsModel, object]:
+    """The dispenser: a square hopper welded above the table, its spheres, and a gate under it on
+    a PD-driven slide along the table's x (closed at 0, open at one width and a wall). Returns the
+    spheres and the gate joint."""
+    d: DispenserConfig = scenario.dispenser
+    radius = d.sphere_radius(scenario.contents)
+    X_WH = dispenser_frame(scenario)
+    instance = plant.AddModelInstance("dispenser")
+    t, w = DISPENSER_WALL, d.width
+    h = hopper_height(d, radius)
+    hopper = plant.AddRigidBody("dispenser_hopper", instance,
+                                SpatialInertia.SolidBoxWithMass(1.0, w, w, h))
+    plant.WeldFrames(plant.world_frame(), hopper.body_frame(), X_WH)
+    rigid = ProximityProperties()
+    AddContactMaterial(friction=CoulombFriction(0.3, 0.3), properties=rigid)
+    AddRigidHydroelasticProperties(rigid)
+    z = GATE_GAP + h / 2
+    for k, (x, y, sx, sy) in enumerate((((w + t) / 2, 0, t, w + 2 * t), (-(w + t) / 2, 0, t,
+                                        w + 2 * t), (0, (w + t) / 2, w, t), (0, -(w + t) / 2,
+                                                                             w, t))):
+        X = RigidTransform([x, y, z])
+        plant.RegisterCollisionGeometry(hopper, X, Box(sx, sy, h), f"wall_{k}", rigid)
+        plant.RegisterVisualGeometry(hopper, _illustration_only(
+            Box(sx, sy, h), f"wall_{k}_visual", X, DISPENSER_COLOR, False))
+    gate = plant.AddRigidBody("dispenser_gate", instance, SpatialInertia.SolidBoxWithMass(
+        GATE_MASS, w + 2 * t, w + 2 * t, t))
+    X = RigidTransform([0, 0, -t / 2])
+    plant.RegisterCollisionGeometry(gate, X, Box(w + 2 * t, w + 2 * t, t), "gate", rigid)
+    plant.RegisterVisualGeometry(gate, _illustration_only(
+        Box(w + 2 * t, w + 2 * t, t), "gate_visual", X, DISPENSER_COLOR, False))
+    joint = plant.AddJoint(PrismaticJoint("dispenser_gate_slide", hopper.body_frame(),
+                                          gate.body_frame(), [1.0, 0.0, 0.0]))
+    actuator = plant.AddJointActuator("dispenser_gate_actuator", joint, GATE_FORCE)
+    actuator.set_controller_gains(PdControllerGains(p=GATE_KP, d=GATE_KD))
+    spheres = plant.AddModelInstance("dispenser_contents")
+    p_H = hopper_sites(d, radius)
+    p_W = p_H @ X_WH.rotation().matrix().T + X_WH.translation()
+    mass = WATER_DENSITY * 4.0 / 3.0 * np.pi * radius**3
+    bodies = add_spheres(plant, spheres, "dispenser_sphere", p_W, radius, mass,
+                         scenario.contents)
+    return ContentsModel(name="dispenser", bodies=bodies, radius=radius), joint
+
+
+def gate_travel(config: DispenserConfig) -> float:
+    """[m] of the gate's slide from closed to open: the hopper's width and both walls."""
+    return config.width + 2 * DISPENSER_WALL + 0.01
+
+
+class DispenserCommand(LeafSystem):
+    """`open` (1-vector; > 0.5 opens) → the gate's desired state (position along the slide [m],
+    velocity 0)."""
+
+    def __init__(self, travel: float):
+        super().__init__()
+        self._travel = travel
+        self.DeclareVectorInputPort("open", 1)
+        self.DeclareVectorOutputPort("desired_state", 2, self._calc)
+
+    def _calc(self, context, output):
+        is_open = self.get_input_port().Eval(context)[0] > 0.5
+        output.SetFromVector([self._travel if is_open else 0.0, 0.0])
+
+
 def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
     """Adds the plant, scene graph, drivers and cameras of `scenario` to `builder`."""
     _check_renderers(scenario)
@@ -213,8 +371,12 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
     X_WT = scenario.X_WT.GetDeterministicValue()
     instances["table"] = add_table(plant, scenario.table_size, X_WT)
     add_surfaces(plant, instances["table"], scenario.surfaces)
-    objects = _add_objects(scenario, plant, parser)
+    contents: list[ContentsModel] = []
+    objects = _add_objects(scenario, plant, parser, contents)
     instances.update(objects)
+    if scenario.dispenser is not None:
+        dispensed, _ = _add_dispenser(plant, scenario)
+        contents.append(dispensed)
 
     # Drivers: PD control on the joint actuators (desired state enters the plant).
     for name, driver in scenario.model_drivers.items():
@@ -234,7 +396,13 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
     plant.Finalize()
 
     station = Station(scenario=scenario, plant=plant, scene_graph=scene_graph,
-                      instances=instances, objects=objects, cameras={})
+                      instances=instances, objects=objects, cameras={}, contents=contents)
+    if scenario.dispenser is not None:
+        command = builder.AddNamedSystem("dispenser_command",
+                                         DispenserCommand(gate_travel(scenario.dispenser)))
+        builder.Connect(command.get_output_port(), plant.get_desired_state_input_port(
+            plant.GetModelInstanceByName("dispenser")))
+        station.inputs["dispenser.open"] = command.get_input_port()
 
     # Ports of the arm and the gripper.
     if "iiwa" in instances:

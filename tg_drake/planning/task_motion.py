@@ -328,3 +328,13 @@ def fill_poses(X_WO: np.ndarray, extents, *, gate: tuple, clearance: float,
         X[:3, 3] = [gate[0], gate[1], gate[2] - clearance - top]
         out.append((X, None))
     return out
+
+
+def dispenser_obstacle(X_WH: np.ndarray, *, side: float, below: float, above: float) -> Surface:
+    """The dispenser as an obstacle box: `side` square about the hopper frame H (the centre of
+    the gate's top, table axes; world pose X_WH), from `below` under H to `above` over it [m]."""
+    X_WB = np.asarray(X_WH, float).copy()
+    X_WB[:3, 3] += X_WB[:3, 2] * (above - below) / 2
+    top = np.asarray(X_WH, float)[:3, 3]
+    return Surface("dispenser", (float(top[0]), float(top[1])), float(top[2] + above), X_WB,
+                   (float(side), float(side), float(above + below)))

@@ -18,6 +18,7 @@ import numpy as np
 
 from tg_drake.outcome import PLACE_XY_TOLERANCE
 from tg_drake.perception.ground_truth import pose_from_transform
+from tg_drake.tasks.contents import ContentsModel, count_contents
 from tg_drake.tasks.outcome import TaskOutcome
 
 # The pose each placing task asks the object to rest in (an entry of tg_drake.types.POSES).
@@ -85,3 +86,12 @@ def judge_pour(task: str, counts: dict, *, into: str, held: bool) -> TaskOutcome
     return TaskOutcome(task, ok, measure,
                        f"{inside} of {total} spheres ({fraction:.0%}) in {into}"
                        + ("" if ok else f" (< {POUR_SUCCESS_FRACTION:.0%})"))
+
+
+def contents_counter(model: ContentsModel, *, containers: dict, table_z: float):
+    """body_poses → where the spheres of `model` are (`count_contents`), the containers given as
+    name → (index of its body in body_poses, LibraryObject) [table_z: m, world]."""
+    def count(body_poses) -> dict:
+        return count_contents(model, body_poses, table_z=table_z, containers={
+            name: (body_poses[index], obj) for name, (index, obj) in containers.items()})
+    return count

@@ -1,0 +1,394 @@
+"""The contents of containers as free spheres: where they start, and where they end up.
+
+A core (numpy only, no Drake systems framework). The station (tg_drake.station) builds the
+spheres from `ContentsConfig`/`DispenserConfig` and start positions computed here; the task check
+counts them with `count_contents`.
+
+"Inside a container" is decided from the container's own mesh in its frame O, not from a box: a
+point is inside when it lies outside the container's solid and the mesh closes it in sideways and
+below — rays from the point in every horizontal direction of O and along −z of O all hit the mesh
+(`enclosed`). A sphere in an upright cup is inside; one in the crook of a handle, on the table
+beside the cup, or above the rim is not (some horizontal ray escapes). The test works for any
+closed (watertight) mesh, so an imported object with no library `dimensions` is handled the same
+way; a mesh with no enclosed volume has no cavity and is refused.
+"""
+
+import dataclasses
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tg_drake.errors import ScenarioError
+from tg_drake.objects import WATER_DENSITY
+from tg_drake.objects import mesh as object_mesh
+
+CONTENTS_MODELS = ("mass", "spheres")
+
+# Defaults chosen by measurement (tests/integration/test_contents.py, the report of issue 21:
+# wall time per simulated second of a full cup, spill and tunnelling in the pour rig).
+SPHERE_RADIUS = 0.008  # [m] measured
+MAX_SPHERES = 40  # [1] measured: a fill at most this many spheres (the lowest lattice sites)
+SPHERE_MODULUS = 1e7  # [Pa] hydroelastic modulus, measured
+SPHERE_RESOLUTION = 0.016  # [m] hydroelastic mesh resolution hint (a coarse sphere), measured
+SPHERE_DISSIPATION = 5.0  # [s/m] Hunt–Crossley dissipation, measured (little bounce)
+SPHERE_FRICTION = 0.3  # [1] static = dynamic Coulomb friction: a loose granular fill
+DISPENSER_COUNT = 20  # [1] spheres in a dispenser by default
+DISPENSER_WIDTH = 0.045  # [m] inner side of the dispenser's square hopper by default
+
+LATTICE_GAP = 0.05  # [1] lattice spacing = 2·radius·(1 + gap): spheres start apart
+CLEARANCE = 1.1  # [1] a start site is at least this many radii from the container's mesh
+ON_TABLE = 3.0  # [radii] a sphere's centre this near the table top lies on the table or on spheres
+# lying on it (one resting in the groove between two stands 2.7 radii high)
+_HORIZONTAL = 12  # rays in O's xy plane for the enclosure test
+
+
+@dataclass
+class ContentsConfig:
+    """Scenario.contents: how a "full" container's contents are simulated."""
+
+    model: str = "mass"  # "mass": the water as a solid cylinder welded inside the container (its
+    # mass and inertia only) | "spheres": free compliant-hydroelastic spheres of the water's mass
+    radius: float = SPHERE_RADIUS  # [m] of each sphere
+    count: int = 0  # [1] spheres per full container; 0: as many as fill the cavity on a lattice,
+    # at most max_count (the lowest sites first)
+    max_count: int = MAX_SPHERES  # [1] bound of a fill (count 0)
+    modulus: float = SPHERE_MODULUS  # [Pa] hydroelastic modulus of a sphere
+    resolution_hint: float = SPHERE_RESOLUTION  # [m] hydroelastic mesh resolution of a sphere
+    dissipation: float = SPHERE_DISSIPATION  # [s/m] Hunt–Crossley dissipation
+    friction: float = SPHERE_FRICTION  # [1] Coulomb friction (static = dynamic)
+
+    def validate(self, where: str = "contents") -> None:
+        if self.model not in CONTENTS_MODELS:
+            raise ScenarioError(f"unknown contents model {self.model!r}; allowed: "
+                                f"{', '.join(CONTENTS_MODELS)}", field=f"{where}.model")
+        _check_count(self.count, f"{where}.count")
+        _check_count(self.max_count, f"{where}.max_count", positive=True)
+        for name, unit in (("radius", "m"), ("modulus", "Pa"), ("resolution_hint", "m")):
+            _check_positive(getattr(self, name), f"{where}.{name}", unit)
+        for name, unit in (("dissipation", "s/m"), ("friction", "1")):
+            _check_positive(getattr(self, name), f"{where}.{name}", unit, allow_zero=True)
+        if self.radius > 0.05:
+            raise ScenarioError(f"a sphere of radius {self.radius} m is no small contents; "
+                                "allowed: 0 < radius ≤ 0.05 [m]", field=f"{where}.radius")
+
+
+@dataclass
+class DispenserConfig:
+    """Scenario.dispenser (optional; pourIn): spheres held in a square hopper above `xy` on the
+    table, its bottom `height` above the table top, released by a gate when the station input
+    `dispenser.open` goes above 0.5."""
+
+    xy: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0])  # [m] the
+    # hopper's centre in the table frame
+    height: float = 0.3  # [m] of the hopper's bottom (the gate) above the table top
+    count: int = 0  # [1] spheres; 0: DISPENSER_COUNT
+    radius: float = 0.0  # [m] of each sphere; 0: contents.radius
+    width: float = DISPENSER_WIDTH  # [m] inner side of the square hopper
+
+    def sphere_radius(self, contents: ContentsConfig) -> float:
+        return self.radius or contents.radius
+
+    def sphere_count(self) -> int:
+        return self.count or DISPENSER_COUNT
+
+    def validate(self, table_size, contents: ContentsConfig, where: str = "dispenser") -> None:
+        if len(self.xy) != 2 or not _finite(self.xy):
+            raise ScenarioError(f"xy must be two finite numbers [m] (the hopper's centre in the "
+                                f"table frame), got {self.xy}", field=f"{where}.xy")
+        half = np.asarray(table_size, float) / 2
+        if np.any(np.abs(self.xy) > half):
+            raise ScenarioError(f"the dispenser at xy={list(self.xy)} is off the table "
+                                f"(|x| ≤ {half[0]}, |y| ≤ {half[1]} in the table frame)",
+                                field=f"{where}.xy")
+        _check_positive(self.height, f"{where}.height", "m")
+        _check_count(self.count, f"{where}.count")
+        _check_positive(self.radius, f"{where}.radius", "m", allow_zero=True)
+        if self.radius > 0.05:
+            raise ScenarioError(f"a sphere of radius {self.radius} m is no small contents; "
+                                "allowed: 0 (contents.radius) or ≤ 0.05 [m]",
+                                field=f"{where}.radius")
+        _check_positive(self.width, f"{where}.width", "m")
+        radius = self.sphere_radius(contents)
+        if self.width < 2 * CLEARANCE * radius:
+            raise ScenarioError(f"a hopper of width {self.width} m holds no sphere of radius "
+                                f"{radius} m; allowed: width ≥ {2 * CLEARANCE * radius:.3g} [m]",
+                                field=f"{where}.width")
+
+
+@dataclass(frozen=True)
+class ContentsModel:
+    """What the station built for one container (or the dispenser)."""
+
+    name: str  # the container's instance name, or "dispenser"
+    bodies: tuple[int, ...]  # indices of the spheres' bodies in the body_poses output
+    radius: float  # [m]
+
+
+def _finite(value) -> bool:
+    try:
+        return bool(np.all(np.isfinite(np.asarray(value, float))))
+    except (TypeError, ValueError):
+        return False
+
+
+def _check_positive(value, field: str, unit: str, *, allow_zero: bool = False) -> None:
+    if isinstance(value, bool) or not _finite(value) or not (
+            value >= 0 if allow_zero else value > 0):
+        raise ScenarioError(f"must be a finite number {'≥' if allow_zero else '>'} 0 [{unit}], "
+                            f"got {value!r}", field=field)
+
+
+def _check_count(value, field: str, *, positive: bool = False) -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < (1 if positive else 0):
+        raise ScenarioError(f"must be a whole number ≥ {1 if positive else 0}, got {value!r}",
+                            field=field)
+
+
+# ------------------------------------------------------------------------------------------------
+# Ray casting on a triangle mesh (Möller–Trumbore), vectorised over points for one direction.
+
+
+def _ray_hits(origins: np.ndarray, direction: np.ndarray, V: np.ndarray, F: np.ndarray,
+              chunk: int = 128) -> tuple[np.ndarray, np.ndarray]:
+    """(first hit distance (n,) [m], inf when none; number of hits (n,)) of rays from `origins`
+    along the unit `direction` on the triangles F of V."""
+    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    e1, e2 = B - A, C - A
+    p = np.cross(direction, e2)
+    det = np.einsum("ij,ij->i", e1, p)
+    ok = np.abs(det) > 1e-15
+    A, e1, e2, p, det = A[ok], e1[ok], e2[ok], p[ok], det[ok]
+    inv = 1.0 / det
+    first = np.full(len(origins), np.inf)
+    hits = np.zeros(len(origins), int)
+    if len(A) == 0:
+        return first, hits
+    for s in range(0, len(origins), chunk):
+        T = origins[s:s + chunk, None, :] - A[None]
+        u = np.einsum("nmk,mk->nm", T, p) * inv
+        q = np.cross(T, e1[None])
+        v = (q @ direction) * inv
+        t = np.einsum("nmk,mk->nm", q, e2) * inv
+        hit = (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-9)
+        hits[s:s + chunk] = hit.sum(axis=1)
+        first[s:s + chunk] = np.where(hit, t, np.inf).min(axis=1)
+    return first, hits
+
+
+def _horizontal_directions() -> np.ndarray:
+    a = (np.arange(_HORIZONTAL) + 0.5) * 2 * np.pi / _HORIZONTAL  # off the mesh's seam planes
+    return np.column_stack([np.cos(a), np.sin(a), np.zeros_like(a)])
+
+
+# Along O's z, tilted by a few mrad so that a ray does not run through the mesh's seams (the
+# generated meshes have vertices on the axis and on the xz and yz planes).
+_UP = np.array([1.3e-3, 2.1e-3, 1.0]) / np.linalg.norm([1.3e-3, 2.1e-3, 1.0])
+_DOWN = -_UP
+_CUBE = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
+                  if (i, j, k) != (0, 0, 0)], float)
+_CUBE /= np.linalg.norm(_CUBE, axis=1, keepdims=True)
+
+
+def _band(V: np.ndarray, F: np.ndarray, z_lo: float, z_hi: float) -> np.ndarray:
+    """The triangles of F that reach into the slab z_lo ≤ z ≤ z_hi."""
+    z = V[F][:, :, 2]
+    return F[(z.max(axis=1) >= z_lo) & (z.min(axis=1) <= z_hi)]
+
+
+def enclosed(p_O: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """(n,) bool: each point of p_O (n, 3) [m, in the container's frame O] lies in the container's
+    cavity — outside its solid (an even number of hits along +z) and closed in by its mesh (V, F)
+    in every horizontal direction of O and below (along −z of O)."""
+    p_O = np.atleast_2d(np.asarray(p_O, float))
+    V = np.asarray(V, float)
+    _, up_hits = _ray_hits(p_O, _UP, V, F)
+    inside = up_hits % 2 == 0
+    down, _ = _ray_hits(p_O, _DOWN, V, F)
+    inside &= np.isfinite(down)
+    for d in _horizontal_directions():
+        if not inside.any():
+            break
+        idx = np.flatnonzero(inside)
+        band = _band(V, F, p_O[idx, 2].min(), p_O[idx, 2].max())
+        dist, _ = _ray_hits(p_O[idx], d, V, band)
+        inside[idx[~np.isfinite(dist)]] = False
+    return inside
+
+
+def _clear(p_O: np.ndarray, V: np.ndarray, F: np.ndarray, distance: float) -> np.ndarray:
+    """(n,) bool: no ray from the point in 26 directions (a cube's faces, edges and corners) hits
+    the mesh within `distance` [m], nor is a mesh vertex that near."""
+    band = _band(V, F, p_O[:, 2].min() - distance, p_O[:, 2].max() + distance)
+    ok = np.ones(len(p_O), bool)
+    if len(band) == 0:
+        return ok
+    for d in _CUBE:
+        ok &= _ray_hits(p_O, d, V, band)[0] >= distance
+    W = V[np.unique(band)]
+    ok &= np.min(np.linalg.norm(p_O[:, None, :] - W[None], axis=2), axis=1) >= distance
+    return ok
+
+
+def _floor(V: np.ndarray, F: np.ndarray) -> float | None:
+    """[m] z of the cavity's floor on O's axis: the second surface a ray up the axis from below
+    meets (the first is the outside of the bottom); None when it meets fewer than two."""
+    o = np.array([[0.0, 0.0, V[:, 2].min() - 0.01]])
+    zs = []
+    for _ in range(2):
+        t, _ = _ray_hits(o, _UP, V, F)
+        if not np.isfinite(t[0]):
+            return None
+        o = o + _UP * (t[0] + 1e-7)
+        zs.append(float(o[0, 2]))
+    return zs[1]
+
+
+def _lattice(lo: np.ndarray, hi: np.ndarray, spacing: float) -> np.ndarray:
+    """Points of a cubic lattice of `spacing` [m] within the box lo..hi, centred in x and y and
+    starting at lo in z; ordered bottom layer first."""
+    axes = []
+    for k in range(3):
+        n = max(int(math.floor((hi[k] - lo[k]) / spacing)) + 1, 0)
+        start = 0.5 * (lo[k] + hi[k]) - 0.5 * (n - 1) * spacing if k < 2 else lo[k]
+        axes.append(start + spacing * np.arange(n))
+    X, Y, Z = np.meshgrid(*axes, indexing="ij")
+    P = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
+    return P[np.lexsort((P[:, 1], P[:, 0], P[:, 2]))]
+
+
+def cavity_sites(V: np.ndarray, F: np.ndarray, radius: float,
+                 max_sites: int | None = None) -> np.ndarray:
+    """(n, 3) [m, in O] sphere centres on a cubic lattice that fit in the container's cavity,
+    layer by layer from its floor up (at most `max_sites`, the lowest first): each centre enclosed
+    (`enclosed`), its top (centre + radius along z) enclosed too so that no sphere stands above
+    the rim, and the sphere clear of the mesh by CLEARANCE radii."""
+    V = np.asarray(V, float)
+    F = np.asarray(F, np.int64)
+    spacing = 2 * radius * (1 + LATTICE_GAP)
+    lo, hi = V.min(axis=0) + radius, V.max(axis=0) - radius
+    floor = _floor(V, F)
+    z0 = lo[2] if floor is None else max(lo[2], floor + CLEARANCE * radius)
+    layer = _lattice(np.array([lo[0], lo[1], 0.0]), np.array([hi[0], hi[1], 0.0]), spacing)
+    sites = []
+    z = z0
+    while z <= hi[2] and (max_sites is None or len(sites) < max_sites):
+        P = layer + [0.0, 0.0, z]
+        P = P[enclosed(P, V, F)]
+        if len(P):
+            P = P[enclosed(P + [0.0, 0.0, radius], V, F)]
+        if len(P):
+            P = P[_clear(P, V, F, CLEARANCE * radius)]
+        sites.extend(P)
+        z += spacing
+    sites = np.array(sites, float).reshape(-1, 3)
+    return sites if max_sites is None else sites[:max_sites]
+
+
+@functools.cache
+def _cavity_sites_cached(key, radius: float, n: int, V_bytes: bytes, F_bytes: bytes, nv: int,
+                         nf: int):
+    V = np.frombuffer(V_bytes, float).reshape(nv, 3)
+    F = np.frombuffer(F_bytes, np.int64).reshape(nf, 3)
+    sites = cavity_sites(V, F, radius, n + 1)
+    sites.setflags(write=False)
+    return sites
+
+
+def container_sites(obj_id: str, V: np.ndarray, F: np.ndarray, config: ContentsConfig,
+                    *, field: str = "contents") -> np.ndarray:
+    """(count, 3) [m, in O] start positions of a full container's spheres (cached per object and
+    radius); ScenarioError naming the field when the cavity holds none or fewer than `count`."""
+    V = np.ascontiguousarray(V, float)
+    F = np.ascontiguousarray(F, np.int64)
+    want = config.count or config.max_count
+    sites = _cavity_sites_cached(obj_id, float(config.radius), want, V.tobytes(), F.tobytes(),
+                                 len(V), len(F))
+    if len(sites) == 0:
+        raise ScenarioError(f"{obj_id}'s mesh encloses no open cavity that holds a sphere of "
+                            f"radius {config.radius} m (a closed mesh is solid); use a smaller "
+                            "radius, contents.model: mass, or containment: empty",
+                            field=f"{field}.radius")
+    n = config.count or min(len(sites), config.max_count)
+    if n > len(sites):
+        raise ScenarioError(f"{obj_id}'s cavity holds {len(sites)} spheres of radius "
+                            f"{config.radius} m, fewer than {n}; allowed: 0 (fill) to "
+                            f"{len(sites)}",
+                            field=f"{field}.count")
+    return np.array(sites[:n])
+
+
+def hopper_sites(config: DispenserConfig, radius: float) -> np.ndarray:
+    """(count, 3) [m] sphere centres in the dispenser's hopper frame H (origin at the centre of
+    the gate's top, z up): a square lattice column within the hopper's inner `width`."""
+    spacing = 2 * radius * (1 + LATTICE_GAP)
+    half = 0.5 * config.width - radius * CLEARANCE
+    if half < 0:
+        raise ScenarioError(f"a hopper of width {config.width} m holds no sphere of radius "
+                            f"{radius} m", field="dispenser.width")
+    per_side = int(math.floor(2 * half / spacing)) + 1
+    xs = (np.arange(per_side) - 0.5 * (per_side - 1)) * spacing
+    layer = np.array([(x, y) for x in xs for y in xs])
+    n = config.sphere_count()
+    layers = -(-n // len(layer))
+    z = radius * CLEARANCE + spacing * np.arange(layers)
+    P = np.array([(x, y, zz) for zz in z for x, y in layer])
+    return P[:n]
+
+
+def hopper_height(config: DispenserConfig, radius: float) -> float:
+    """[m] inner height of the hopper: its spheres' column and one diameter more."""
+    top = hopper_sites(config, radius)[:, 2].max()
+    return float(top + 3 * radius)
+
+
+# ------------------------------------------------------------------------------------------------
+# Where the spheres are.
+
+
+def _translation(X) -> np.ndarray:
+    if hasattr(X, "translation"):
+        return np.asarray(X.translation(), float)
+    return np.asarray(X, float)[:3, 3]
+
+
+def _matrix(X) -> np.ndarray:
+    if hasattr(X, "GetAsMatrix4"):
+        return np.asarray(X.GetAsMatrix4(), float)
+    return np.asarray(X, float)
+
+
+def count_contents(model: ContentsModel, body_poses, *,
+                   containers: dict[str, tuple[np.ndarray, object]],
+                   table_z: float, mesh_of=object_mesh) -> dict[str, int]:
+    """Where every sphere of `model` is: keys = each container's name (given as name → (X_WO 4×4
+    or RigidTransform, LibraryObject)), "table", "floor", "elsewhere"; the counts sum to
+    len(model.bodies).
+
+    A sphere is in the first container whose cavity encloses its centre (`enclosed`, in that
+    container's frame); else on the table when its centre is within ON_TABLE radii above the
+    table top `table_z` [m, world z] (on it, or on spheres lying on it); on the floor when below the table top (it fell off); elsewhere
+    otherwise (in the air, in the hopper, on the gripper, on another object). `mesh_of(obj)` gives
+    (V, F, ...) of a container (tg_drake.objects.mesh by default)."""
+    p_W = np.array([_translation(body_poses[int(b)]) for b in model.bodies]).reshape(-1, 3)
+    counts = {name: 0 for name in containers}
+    counts.update(table=0, floor=0, elsewhere=0)
+    left = np.ones(len(p_W), bool)
+    for name, (X_WO, obj) in containers.items():
+        if not left.any():
+            break
+        X = _matrix(X_WO)
+        p_O = (p_W[left] - X[:3, 3]) @ X[:3, :3]
+        V, F = mesh_of(obj)[:2]
+        inside = enclosed(p_O, np.asarray(V, float), np.asarray(F))
+        idx = np.flatnonzero(left)[inside]
+        counts[name] += len(idx)
+        left[idx] = False
+    z = p_W[left, 2]
+    on_table = (z >= table_z) & (z <= table_z + ON_TABLE * model.radius)
+    floor = z < table_z
+    counts["table"] += int(on_table.sum())
+    counts["floor"] += int(floor.sum())
+    counts["elsewhere"] += int((~on_table & ~floor).sum())
+    return counts
