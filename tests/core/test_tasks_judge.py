@@ -72,3 +72,23 @@ def test_outcome_as_dict_and_task_names():
                            "detail": "resting on shelf"}
     with pytest.raises(ValueError, match="allowed"):
         TaskOutcome("juggle", True)
+
+
+def test_the_contents_counter_reads_the_containers_poses_from_body_poses():
+    from tg_drake.objects import get_object
+    from tg_drake.tasks.contents import ContentsModel
+    from tg_drake.tasks.judge import contents_counter
+
+    cup = get_object("cup_01")
+    X_WO = np.eye(4)
+    X_WO[:3, 3] = [0.7, 0.1, 0.0]
+    inside = np.eye(4)
+    inside[:3, 3] = X_WO[:3, 3] + np.asarray(cup.cavity_centroid)
+    on_table = np.eye(4)
+    on_table[:3, 3] = [0.5, -0.2, 0.005]
+    body_poses = [np.eye(4), X_WO, inside, on_table]  # body 1: the cup; 2, 3: spheres
+    count = contents_counter(ContentsModel("cup", (2, 3), 0.005),
+                             containers={"cup": (1, cup)}, table_z=0.0)
+    assert count(body_poses) == {"cup": 1, "table": 1, "floor": 0, "elsewhere": 0}
+    out = judge_pour("pourIn", count(body_poses), into="cup", held=True)
+    assert not out.success and out.measure["poured_fraction"] == 0.5
