@@ -532,9 +532,12 @@ class Supervisor(LeafSystem):
         waiting = {Phase.gate: "waiting for the gate check",
                    Phase.planning: f"waiting for plan attempt {memory.attempt}",
                    Phase.executing: f"executing the plan (checks passed: {memory.checks_passed})"}
+        # A run stopped now (a timeout, an error) has not done its task.
+        task = (TaskOutcome(self._task, False, {}, f"not done: {waiting[memory.phase]}")
+                if self._task else None)
         output.set_value(Outcome(Status.pending, Reason.none, waiting[memory.phase],
                                  unreachable_parts=memory.collisions,
-                                 requeries=memory.requeries))
+                                 requeries=memory.requeries, task_outcome=task))
 
 
 def _touches(contact_results, a: frozenset, b: frozenset) -> bool:
