@@ -11,7 +11,8 @@ TASKS = Path(__file__).resolve().parents[2] / "scenarios" / "tasks"
 
 
 def test_every_task_scenario_is_a_case():
-    cases = {"can_on_shelf", "can_sideways", "can_upsidedown", "glass_upright"}
+    cases = {"can_on_shelf", "can_sideways", "can_upsidedown", "glass_upright", "mug_pour_out",
+             "glass_pour_in"}
     assert {p.stem for p in TASKS.glob("*.yaml")} >= cases
 
 
@@ -47,3 +48,19 @@ def test_a_glass_lying_down_is_stood_up_in_the_hand(cached_run):
     task = task_outcome(cached_run, "glass_upright")
     assert task["success"], task
     assert task["measure"]["rest_pose"] == "upright" and task["measure"]["distance_m"] < 0.05
+
+
+@pytest.mark.slow
+def test_a_full_mug_is_poured_into_the_bowl(cached_run):
+    task = task_outcome(cached_run, "mug_pour_out")
+    assert task["task"] == "pourOut" and task["measure"]["into"] == "bowl"
+    counts = task["measure"]["counts"]
+    assert sum(counts.values()) > 0  # every sphere accounted for, in one place each
+    assert task["success"], task
+
+
+@pytest.mark.slow
+def test_an_empty_glass_is_filled_under_the_dispenser(cached_run):
+    task = task_outcome(cached_run, "glass_pour_in")
+    assert task["task"] == "pourIn"
+    assert task["success"], task
