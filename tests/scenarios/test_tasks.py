@@ -64,3 +64,12 @@ def test_an_empty_glass_is_filled_under_the_dispenser(cached_run):
     task = task_outcome(cached_run, "glass_pour_in")
     assert task["task"] == "pourIn"
     assert task["success"], task
+
+
+@pytest.mark.slow
+def test_where_the_reach_forbids_turning_it_in_the_hand_the_failure_says_so(cached_run):
+    result = cached_run(TASKS / "bottle_upright.yaml", None)
+    assert (result["outcome"]["status"], result["outcome"]["reason"]) == ("failed", "unreachable")
+    assert "turned to rest upright in the hand" in result["outcome"]["detail"]
+    assert "place-and-regrasp is not implemented" in result["outcome"]["detail"]
+    assert not result["task_outcome"]["success"]
