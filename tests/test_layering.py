@@ -4,7 +4,7 @@ Every `import` and `from ... import` statement in tg_drake/ is read with `ast`, 
 (module level, inside functions or methods, under `if TYPE_CHECKING:`), and resolved to an
 absolute module name. Two rules:
 
-1. The cores (tg_drake.perception, kernels, logic, grasping, planning) import neither the Drake
+1. The cores (tg_drake.perception, kernels, logic, grasping, planning, importing, tasks) import neither the Drake
    systems framework (pydrake.systems.*), the simulation (tg_drake.station, tg_drake.simulation),
    the systems (tg_drake.systems), evaluation (tg_drake.evaluation, tg_drake.executor) nor the
    application (tg_drake.run, cli, diagram, render).
@@ -31,7 +31,7 @@ import pytest
 
 import tg_drake
 
-CORES = ("perception", "kernels", "logic", "grasping", "planning", "importing")
+CORES = ("perception", "kernels", "logic", "grasping", "planning", "importing", "tasks")
 FORBIDDEN_IN_CORES = (
     "pydrake.systems",
     "tg_drake.station", "tg_drake.simulation", "tg_drake.systems",

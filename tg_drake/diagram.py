@@ -7,7 +7,8 @@
 The same builder is the public way to compose our systems with your own: `add_pipeline` returns
 every system it added (`pipeline.perception`, `.prior`, `.logic`, `.scoring`, `.feasibility`,
 `.planner`, `.supervisor` and the `station`), so you can add systems of yours to the same
-builder and connect them to any port — or call `add_station` alone and wire only the stages you want.
+builder and connect them to any port — or call `add_station` alone and wire only the stages you
+want.
 
 Wiring (docs/design.md, "The diagram"):
 
@@ -39,9 +40,10 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.grasping.model import load_model
-from tg_drake.objects import box_centre
-from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario
-from tg_drake.station import Station, add_station, placement_pose
+from tg_drake.objects import box_centre, get_object
+from tg_drake.planning.task_motion import dispenser_obstacle, surfaces_in_world, task_placing
+from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario, place_surface
+from tg_drake.station import DISPENSER_WALL, Station, add_station, dispenser_frame, placement_pose
 from tg_drake.systems.depth_noise import DepthNoise
 from tg_drake.systems.dgi_system import DgiScoringSystem
 from tg_drake.systems.feasibility_system import GraspFeasibility
@@ -50,7 +52,10 @@ from tg_drake.systems.kernel_prior_system import KernelPriorSystem
 from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
 from tg_drake.systems.perception_system import GroundTruthPerception, PerceptionSystem
 from tg_drake.systems.supervisor import MonitorModel, Supervisor
+from tg_drake.table import surface_body_name
 from tg_drake.targeting import select_target
+from tg_drake.tasks.contents import hopper_height
+from tg_drake.tasks.judge import contents_counter
 from tg_drake.types import SceneDescription
 
 
@@ -94,6 +99,25 @@ class Pipeline:
     task: LeafSystem
     config: PipelineConfig
     ports: dict = field(default_factory=dict)  # stage output ports by name
+
+
+def _contents_counter(scenario: Scenario, station: Station, target_placement):
+    """The supervisor's contents counter of the task (`tg_drake.tasks.judge.contents_counter`):
+    pourOut counts the target's spheres in the target and the bowl, pourIn the dispenser's in
+    the target; None when the station has no such spheres."""
+    task = scenario.task.task
+    source = {"pourOut": target_placement.instance_name, "pourIn": "dispenser"}.get(task)
+    model = next((m for m in station.contents if m.name == source), None)
+    if model is None:
+        return None
+    names = [target_placement.instance_name]
+    if task == "pourOut" and scenario.task.pour_into:
+        names.append(scenario.task.pour_into)
+    placements = {p.instance_name: p for p in scenario.objects}
+    containers = {n: (int(station.object_body(n).index()), get_object(placements[n].id))
+                  for n in names}
+    return contents_counter(model, containers=containers,
+                            table_z=float(scenario.X_WT.GetDeterministicValue().translation()[2]))
 
 
 def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
@@ -171,9 +195,29 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     builder.Connect(scoring.GetOutputPort("ranked_grasps"),
                     feasibility.GetInputPort("ranked_grasps"))
     ranked = feasibility.GetOutputPort("ranked_grasps")
+    # The task's placing: a resting pose to turn the object into, or a surface to put it on.
+    surfaces = surfaces_in_world(scenario.surfaces, X_WT.GetAsMatrix4())
+    surface = place_surface(scenario)
+    pour_at = None  # the bowl's box centre, as the user points at it
+    for placement in scenario.objects:
+        if scenario.task.pour_into and placement.instance_name == scenario.task.pour_into:
+            pour_at = placement_pose(scenario, placement).multiply(box_centre(placement.id))[:2]
+    fill_at = None  # pourIn: under the dispenser's gate; its hopper is an obstacle
+    if scenario.dispenser is not None:
+        X_WH = dispenser_frame(scenario).GetAsMatrix4()
+        d = scenario.dispenser
+        fill_at = X_WH[:3, 3] - X_WH[:3, 2] * DISPENSER_WALL  # the gate's underside
+        surfaces.append(dispenser_obstacle(
+            X_WH, side=d.width + 2 * DISPENSER_WALL, below=DISPENSER_WALL,
+            above=hopper_height(d, d.sphere_radius(scenario.contents)) + DISPENSER_WALL))
+    placing = task_placing(scenario.task.task, place_xy=place_xy_W, pour_at=pour_at,
+                           fill_at=fill_at, table_z=float(X_WT.translation()[2]),
+                           surface=next((s for s in surfaces if surface is not None
+                                         and s.name == surface.name), None),
+                           config=config.tasks)
     planner = builder.AddNamedSystem("planner", GraspPlanner(
         place_xy=place_xy_W, start_time=supervision.planning_start + supervision.period,
-        config=config.planner, scenario=scenario))
+        config=config.planner, scenario=scenario, placing=placing, surfaces=surfaces))
     builder.Connect(scene, planner.GetInputPort("scene_description"))
     builder.Connect(ranked, planner.GetInputPort("ranked_grasps"))
     builder.Connect(station.outputs["iiwa.state"], planner.GetInputPort("iiwa.state"))
@@ -186,7 +230,16 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
         config=supervision, model=MonitorModel.from_plant(
             plant, object_body=station.object_body(target_placement.instance_name),
             wsg_instance=station.instances["wsg"], table_instance=station.instances["table"],
-            p_OC=box_centre(target_placement.id))))
+            p_OC=box_centre(target_placement.id), X_WT=X_WT.GetAsMatrix4(),
+            is_tool=get_object(target_placement.id).is_tool,
+            surfaces=[(s.name, surface_body_name(s.name)) for s in scenario.surfaces]),
+        task=scenario.task.task, place_on=surface.name if surface is not None else "",
+        pour_into=scenario.task.pour_into, container=target_placement.instance_name,
+        count_contents=_contents_counter(scenario, station, target_placement),
+        dispense_duration=config.tasks.fill_open))
+    if "dispenser.open" in station.inputs:
+        builder.Connect(supervisor.GetOutputPort("dispenser_command"),
+                        station.inputs["dispenser.open"])
     builder.Connect(scene, supervisor.GetInputPort("scene_description"))
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     supervisor.GetInputPort("grasp_semantics"))

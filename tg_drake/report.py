@@ -129,6 +129,8 @@ def result_of(*, scenario, scenario_path: str, stages: Stages, outcome, plan_sta
                                           and ranked.p_hold is not None else None),
                                "score": float(ranked.score[i]) if known else None}
     result["outcome"] = outcome.as_dict()
+    if outcome.task_outcome is not None:
+        result["task_outcome"] = outcome.task_outcome.as_dict()
     if stages.warnings:
         result["warnings"] = list(stages.warnings)
     result["timings"] = {k: round(v, 4) for k, v in timings.items()}
@@ -298,6 +300,10 @@ def summary(result: dict) -> str:
                      f"{_hold_text(g)})")
     status = o["status"] + (f" ({o['reason']})" if o["reason"] else "")
     lines.append(f"outcome    {status}: {o['detail']}")
+    if result.get("task_outcome"):
+        task = result["task_outcome"]
+        lines.append(f"task check {task['task']} {'succeeded' if task['success'] else 'failed'}: "
+                     f"{task['detail']}")
     if o["unreachable_parts"]:
         lines.append(f"closed loop: unreachable parts {o['unreachable_parts']} became "
                      f"collision evidence; {o['requeries']} "

@@ -43,6 +43,7 @@ from tg_drake.objects import PACKAGE, add_library, get_object, mesh, register_ob
 from tg_drake.perception.config import PerceptionConfig
 from tg_drake.perception.sensor_model import IdealDepth, SensorModel, StructuredLight
 from tg_drake.planning.planner import PlannerConfig
+from tg_drake.planning.task_motion import TaskMotionConfig
 from tg_drake.robot import WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
 from tg_drake.robot_plants import default_directives
 from tg_drake.schema_check import SchemaError, check_document, load_raw
@@ -196,6 +197,19 @@ class TaskConfig:
     task: str = ""  # one of TASKS; "" = infer the task
     place_xy: list[float] = field(default_factory=lambda: [0.0, -0.3])  # place target, table frame
     ground_truth: GroundTruth = field(default_factory=GroundTruth)
+    place_on: str = ""  # p&pOn: the name of the surface (`surfaces`) to place the object on;
+    # "" = the first surface. The object goes to the surface's centre, not to `place_xy`.
+    pour_into: str = ""  # pourOut: the instance name of the scene object poured into (a bowl)
+
+
+@dataclass
+class SurfaceConfig:
+    """A box standing on the table (a shelf, a board), welded to it with a compliant-hydroelastic
+    top like the table's; p&pOn places the object on one."""
+
+    name: str = ""  # unique among the surfaces
+    xy: list[float] = field(default_factory=lambda: [0.0, 0.0])  # centre, table frame [m]
+    size: list[float] = field(default_factory=lambda: [0.2, 0.2, 0.05])  # x, y, height [m]
 
 
 @dataclass
@@ -300,6 +314,8 @@ class PipelineConfig:
     planner: PlannerConfig = field(default_factory=PlannerConfig)  # the pick-and-place plan
     supervisor: SupervisorConfig = field(default_factory=SupervisorConfig)  # the closed loop:
     # gate, re-queries, waiting for plans, execution monitor
+    tasks: TaskMotionConfig = field(default_factory=TaskMotionConfig)  # the task motions:
+    # reorienting to a resting pose, placing on a surface, pouring
 
     def validate(self, where: str = "pipeline") -> None:
         """Checks names the YAML types cannot; raises ScenarioError naming the field."""
@@ -331,6 +347,7 @@ class PipelineConfig:
                                 field=f"{where}.scoring.model")
         self.feasibility.validate(f"{where}.feasibility")
         self.supervisor.validate(f"{where}.supervisor")
+        self.tasks.validate(f"{where}.tasks")
 
     @property
     def ground_truth_perception(self) -> bool:
@@ -365,6 +382,7 @@ class Scenario:
     object_libraries: list[str] = field(default_factory=list)  # user library folders (relative
     # to the scenario file) whose objects `objects` may name
     task: TaskConfig = field(default_factory=TaskConfig)
+    surfaces: list[SurfaceConfig] = field(default_factory=list)  # boxes on the table (p&pOn)
     pipeline: PipelineConfig = field(default_factory=PipelineConfig)
     # The table: its top's size (x, y) [m] and where its top frame T sits in the world. The station
     # builds the table from these (tg_drake.table); objects must stand within the top.
@@ -562,6 +580,7 @@ def validate(scenario: Scenario, *, where: str = "<scenario>",
     try:
         _validate_simulation(scenario)
         _validate_geometry(scenario)
+        _validate_surfaces(scenario)
         _validate_contents(scenario)
     except ScenarioError as e:
         raise ScenarioError(e.message, file=where, field=e.field) from None
@@ -835,6 +854,62 @@ def _validate_geometry(scenario: Scenario) -> None:
                     field=f"objects[{max(i, j)}].xy")
 
 
+def place_surface(scenario: Scenario) -> SurfaceConfig | None:
+    """The surface p&pOn places the object on (`task.place_on`, else the first), or None when the
+    task is not p&pOn or the scenario has no surfaces (the object is then placed on the table at
+    `place_xy`, and the task check fails saying so)."""
+    if scenario.task.task != "p&pOn" or (not scenario.surfaces and not scenario.task.place_on):
+        return None
+    name = scenario.task.place_on or scenario.surfaces[0].name
+    for surface in scenario.surfaces:
+        if surface.name == name:
+            return surface
+    raise unknown_name("surface", name, [s.name for s in scenario.surfaces],
+                       error=ScenarioError, field="task.place_on")
+
+
+def _validate_surfaces(scenario: Scenario) -> None:
+    """Surfaces: named uniquely, positive finite sizes, standing on the table top, under no
+    object; p&pOn's `place_on` names one, pourOut's `pour_into` names another object."""
+    half = np.asarray(scenario.table_size) / 2
+    names = set()
+    for i, surface in enumerate(scenario.surfaces):
+        f = f"surfaces[{i}]"
+        if not surface.name:
+            raise ScenarioError("a surface needs a `name`", field=f"{f}.name")
+        if surface.name in names:
+            raise ScenarioError(f"two surfaces are named {surface.name!r}", field=f"{f}.name")
+        names.add(surface.name)
+        if len(surface.xy) != 2 or not _finite(surface.xy):
+            raise ScenarioError(f"xy must be two finite numbers [m], got {surface.xy}",
+                                field=f"{f}.xy")
+        if len(surface.size) != 3 or not _finite(surface.size) or min(surface.size) <= 0:
+            raise ScenarioError(f"size must be three finite numbers > 0 (x, y, height) [m], got "
+                                f"{surface.size}", field=f"{f}.size")
+        lo = np.asarray(surface.xy) - np.asarray(surface.size[:2]) / 2
+        hi = np.asarray(surface.xy) + np.asarray(surface.size[:2]) / 2
+        if np.any(lo < -half) or np.any(hi > half):
+            raise ScenarioError(
+                f"surface {surface.name!r} ({lo.round(3).tolist()} to {hi.round(3).tolist()}) "
+                f"reaches off the table (|x| ≤ {half[0]}, |y| ≤ {half[1]} in the table frame)",
+                field=f"{f}.xy")
+        for j, placement in enumerate(scenario.objects):
+            p = _footprint_points(scenario, placement)[:, :2]
+            if np.all(p.max(0) > lo) and np.all(p.min(0) < hi):
+                raise ScenarioError(
+                    f"surface {surface.name!r} stands under {placement.instance_name} "
+                    f"(objects[{j}]): objects stand on the table; move one of them",
+                    field=f"{f}.xy")
+    place_surface(scenario)
+    into = scenario.task.pour_into
+    if into:
+        names = [p.instance_name for p in scenario.objects]
+        if into not in names:
+            raise unknown_name("object to pour into", into, names, error=ScenarioError,
+                               field="task.pour_into")
+        if scenario.objects and into == scenario.target_placement().instance_name:
+            raise ScenarioError("the object poured into is the target itself",
+                                field="task.pour_into")
 def _validate_contents(scenario: Scenario) -> None:
     """The contents block, the dispenser, and (spheres) that each full container's cavity holds
     its spheres."""

@@ -93,7 +93,7 @@ from tg_drake.scenario import (
     WsgPdDriver,
     resolve_objects,
 )
-from tg_drake.table import add_table
+from tg_drake.table import add_surfaces, add_table
 from tg_drake.tasks.contents import (
     DISPENSER_WALL,
     ContentsConfig,
@@ -382,6 +382,7 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
                             field="directives")
     X_WT = scenario.X_WT.GetDeterministicValue()
     instances["table"] = add_table(plant, scenario.table_size, X_WT)
+    add_surfaces(plant, instances["table"], scenario.surfaces)
     contents: list[ContentsModel] = []
     objects = _add_objects(scenario, plant, parser, contents)
     instances.update(objects)

@@ -13,10 +13,11 @@ in from each edge and reach the floor TABLE_HEIGHT below the surface, whatever t
 from __future__ import annotations
 
 import numpy as np
+from pydrake.geometry import AddCompliantHydroelasticProperties, Box, ProximityProperties
 from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
-from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import ModelInstanceIndex
+from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
+from pydrake.multibody.tree import ModelInstanceIndex, SpatialInertia
 
 # Where the table-top frame T sits in the world (its surface at the iiwa base height). Its centre
 # is 0.75 m in front of the base: side grasps at 0.7–0.9 m and top grasps at 0.45–0.8 m are within
@@ -103,3 +104,38 @@ def table_size_problem(size) -> str | None:
         return (f"table_size {list(size)} is too small: each side at least {MIN_TABLE_SIZE:g} m "
                 "(the legs stand inside the top)")
     return None
+
+
+SURFACE_MASS = 1.0  # [kg] of a surface box (welded to the table: it only fills the model)
+SURFACE_COLOR = (0.55, 0.42, 0.3, 1.0)  # RGBA of a surface's visual
+
+
+def surface_body_name(name: str) -> str:
+    """The body of surface `name` in the table's model instance."""
+    return f"surface_{name}"
+
+
+def add_surfaces(plant: MultibodyPlant, table: ModelInstanceIndex, surfaces) -> list:
+    """Adds each surface (`tg_drake.scenario.SurfaceConfig`: `name`, centre `xy` in the table
+    frame, `size` (x, y, height) [m]) to the table's model instance, before Finalize: a box
+    standing on the table top, welded to it, compliant-hydroelastic like the top (TABLE_HYDRO).
+    Returns their bodies."""
+    top = plant.GetFrameByName("table_top", table)
+    h = TABLE_HYDRO
+    bodies = []
+    for s in surfaces:
+        sx, sy, sz = (float(v) for v in s.size)
+        body = plant.AddRigidBody(surface_body_name(s.name), table,
+                                  SpatialInertia.SolidBoxWithMass(SURFACE_MASS, sx, sy, sz))
+        box = Box(sx, sy, sz)
+        props = ProximityProperties()
+        AddCompliantHydroelasticProperties(h["resolution"], h["modulus"], props)
+        props.AddProperty("material", "hunt_crossley_dissipation", h["dissipation"])
+        props.AddProperty("material", "coulomb_friction", CoulombFriction(h["mu"], h["mu"]))
+        plant.RegisterCollisionGeometry(body, RigidTransform(), box, f"surface_{s.name}", props)
+        plant.RegisterVisualGeometry(body, RigidTransform(), box, f"surface_{s.name}_visual",
+                                     np.array(SURFACE_COLOR))
+        plant.WeldFrames(top, body.body_frame(), RigidTransform([float(s.xy[0]),
+                                                                 float(s.xy[1]), sz / 2]))
+        bodies.append(body)
+    return bodies

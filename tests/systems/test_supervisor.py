@@ -5,6 +5,8 @@ and the scenario tests.)"""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from grasp_helpers import grasp_pose, ranked, scene_with_box
@@ -55,8 +57,8 @@ GRASPS = ranked([(FROM_BELOW, "bottom"), (TOP, "top")])
 class Fixed:
     """The supervisor alone, its inputs fixed; `advance` moves simulated time."""
 
-    def __init__(self, *, config=CONFIG, scene=SCENE, meaning=None, grasps=GRASPS):
-        self.supervisor = Supervisor(config=config, model=NO_MODEL)
+    def __init__(self, *, config=CONFIG, scene=SCENE, meaning=None, grasps=GRASPS, **task):
+        self.supervisor = Supervisor(config=config, model=NO_MODEL, **task)
         self.context = self.supervisor.CreateDefaultContext()
         s = self.supervisor
         s.get_scene_description_input_port().FixValue(self.context, scene)
@@ -103,6 +105,38 @@ def test_gate_passes_and_asks_for_the_first_plan():
     assert f.request == PlanRequest(attempt=1, exclude_parts=())
     assert (f.outcome.status, f.outcome.final) == (Status.pending, False)
     assert "attempt 1" in f.outcome.detail
+
+
+def test_a_given_task_gets_a_failed_task_outcome_when_the_run_ends_early():
+    f = Fixed(meaning=semantics(grasp_probability=0.01), task="p&pInUpsidedown")
+    f.advance(0.001)
+    task = f.outcome.task_outcome
+    assert f.outcome.final and task is not None
+    assert (task.task, task.success) == ("p&pInUpsidedown", False)
+    assert "not done" in task.detail and "logic" in task.detail
+    assert f.outcome.as_dict()["task_outcome"]["success"] is False
+
+
+def test_the_dispenser_opens_while_a_pour_in_plan_holds_the_container_under_it():
+    f = Fixed(task="pourIn", dispense_duration=1.5)
+    port = f.supervisor.get_dispenser_command_output_port()
+    f.advance(0.001)
+    # The monitor's first check (the grasp) lies after this test's times: only the hold matters.
+    plan = SimpleNamespace(t_grasp_closed=100.0, t_lift_done=101.0, duration=102.0,
+                           t_pour=(2.0, 4.5))
+    f.plan(PlanStatus(PlanState.executing, attempt=1, t_plan=0.5, plan=plan))
+    command = []
+    for t in (0.5, 2.4, 2.6, 3.9, 4.1, 6.0):
+        f.advance(t)
+        command.append(port.Eval(f.context)[0])
+    assert command == [0.0, 0.0, 1.0, 1.0, 0.0, 0.0]  # open over [2.5, 4.0) s
+
+
+def test_no_task_given_no_task_outcome():
+    f = Fixed(meaning=semantics(grasp_probability=0.01))
+    f.advance(0.001)
+    assert f.outcome.final and f.outcome.task_outcome is None
+    assert f.outcome.as_dict()["task_outcome"] is None
 
 
 @pytest.mark.parametrize("kwargs, detail", [

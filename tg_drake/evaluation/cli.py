@@ -25,7 +25,6 @@ import zlib
 from pathlib import Path
 
 from tg_drake.errors import ScenarioError, unknown_name
-from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
 from tg_drake.evaluation.shards import (
     merge,
     object_set,
@@ -34,6 +33,7 @@ from tg_drake.evaluation.shards import (
     shard,
     shard_file,
 )
+from tg_drake.executor import EXECUTORS, Job, make_executor, run_jobs
 from tg_drake.executor import read_records as read_results
 from tg_drake.types import THEORY_VARIANTS as VARIANTS
 

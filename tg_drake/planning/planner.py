@@ -49,7 +49,16 @@ import numpy as np
 from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
+from tg_drake.grasping.feasibility import GRASP_DEPTH  # noqa: F401  (scripted.py reads it here)
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
+from tg_drake.planning.task_motion import (
+    TaskPlacing,
+    bowl_of,
+    box_top,
+    fill_poses,
+    pour_poses,
+    turned_retreat,
+)
 from tg_drake.planning.trajectory import (
     SegmentConfig,
     SegmentLimits,
@@ -57,7 +66,6 @@ from tg_drake.planning.trajectory import (
     plan_segment,
     shifted,
 )
-from tg_drake.grasping.feasibility import GRASP_DEPTH  # noqa: F401  (scripted.py reads it here)
 from tg_drake.robot import (
     IIWA_HOME,
     WSG_FINGERTIP_Y,
@@ -152,6 +160,10 @@ class Plan:
     X_WO_place: np.ndarray  # 4×4 object pose at release
     waypoints: dict  # name → (7,) iiwa configuration
     segments: tuple  # (name, t_start, t_end, min_clearance [m]) per moving segment
+    R_turn: np.ndarray | None = None  # 3×3 world-frame rotation the plan gives the object
+    # beyond a turn about the vertical (a task's resting pose); None: its orientation is kept
+    t_pour: tuple | None = None  # [s] (start, end) of holding the container tilted over the
+    # bowl (pourOut) or under the dispenser (pourIn); None when the plan pours nothing
 
     def q(self, t: float) -> np.ndarray:
         """(7,) joint positions at plan time t (held at the ends outside [0, duration])."""
@@ -212,7 +224,8 @@ def plan_for_scene(scene: SceneDescription, candidates: GraspCandidates, *, plac
 def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescription,
                         obstacles=(), place_xy, q_start=IIWA_HOME, table_z: float = 0.0,
                         config: PlannerConfig | None = None, scenario=None,
-                        exclude_parts=(), max_parts: int | None = None) -> PlanResult:
+                        exclude_parts=(), max_parts: int | None = None,
+                        placing: TaskPlacing | None = None, surfaces=()) -> PlanResult:
     """The first candidate (by score) with a full collision-free pick-and-place plan.
 
     Args:
@@ -225,6 +238,10 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         exclude_parts: part names not to try (already found unreachable).
         max_parts: try only the candidates of the first this many parts (in order of their best
             candidate); None tries all.
+        placing: the task's placing (`tg_drake.planning.task_motion.task_placing`: a resting
+            pose to turn the object into, a surface to put it on); None places it at `place_xy`
+            on the table, its orientation kept.
+        surfaces: `Surface` boxes standing on the table, obstacles of every motion.
     """
     config = config or PlannerConfig()
     t_start = time.perf_counter()
@@ -263,8 +280,14 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
     X_WO = np.asarray(target.X_WO, float)
     X_WO_place = place_pose(X_WO, target.extents, place_xy, table_z=table_z,
                             release_height=config.release_height)
+    if placing is not None:
+        place_xy = placing.place_xy
+        X_WO_place = place_pose(X_WO, target.extents, place_xy, table_z=placing.support_z,
+                                release_height=config.release_height)
     boxes = [(f"object{i}", RigidTransform(o.X_WO), tuple(o.extents))
              for i, o in enumerate(obstacles)]
+    boxes += [(f"surface_{s.name}", RigidTransform(np.asarray(s.X_WB)), tuple(s.size))
+              for s in surfaces]
     target_box = target_shapes(target)
     placed_box = ("target_placed", RigidTransform(X_WO_place), tuple(target.extents))
     arms = _Arms(scenario, config.open_width, boxes, target_box, placed_box)
@@ -288,8 +311,24 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             costs[i], reasons[i] = np.inf, refusal
             continue
         found = False
-        for X_WO_place_yawed in _place_variants(X_WO_place, config):
-            key = _key_poses(arms, X_WG, X_WO, X_WO_place_yawed, config)
+        places = _task_place_variants(X_WO_place, config, placing=placing, X_WO=X_WO,
+                                      X_WG=X_WG, extents=target.extents, is_tool=target.is_tool)
+        if not places:
+            costs[i] = np.inf
+            reasons[i] = _farthest(reasons[i], f"place pose: {target_name(target)} cannot "
+                                   f"be turned to rest {placing.pose}")
+            continue
+        pours, why = _pours(placing, obstacles, target, X_WG)
+        if not pours:
+            costs[i], reasons[i] = np.inf, _farthest(reasons[i], why)
+            continue
+        failed_pours = set()
+        for k_pour, pour, R_turn, X_WO_place_yawed in [
+                (k, pour, R, X) for k, pour in enumerate(pours) for R, X in places]:
+            if k_pour in failed_pours:
+                continue
+            key = _key_poses(arms, X_WG, X_WO, X_WO_place_yawed, config, R_turn=R_turn,
+                             pour=pour, pour_hold=placing.hold if pour else 0.0)
             below = [n for n in ("pre-grasp", "grasp") if key.X[n].translation()[2] < table_z]
             if below:  # the WSG body's origin under the table top: no need to ask the IK
                 costs[i] = np.inf
@@ -299,6 +338,11 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             poses, failure = _waypoint_configurations(arms, key, seeds, config)
             if "pre-grasp" in poses:
                 part_reachable[part] = True
+            if failure and R_turn is not None and failure.startswith(PLACE_FAILURES):
+                failure += (f", the object turned to rest {placing.pose} in the hand "
+                            "(a place-and-regrasp is not implemented)")
+            if failure.startswith(POUR_FAILURES):  # another pour may do
+                failed_pours.add(k_pour)
             if failure:
                 # Failing on a place pose, the pick poses were reachable (motions untried): the
                 # object turned another way at the place may do.
@@ -311,7 +355,12 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             plan, failure, picked = _trajectories(arms, q_start, poses, key, config, seeds,
                                                   candidate=int(i), part=part)
             part_pickable[part] |= picked
+            if plan is None and R_turn is not None and failure.startswith(PLACE_FAILURES):
+                failure += (f", the object turned to rest {placing.pose} in the hand "
+                            "(a place-and-regrasp is not implemented)")
             if plan is None:
+                if failure.startswith(POUR_FAILURES):
+                    failed_pours.add(k_pour)
                 costs[i], reasons[i] = np.inf, _farthest(reasons[i], failure)
                 if picked:
                     continue
@@ -361,6 +410,52 @@ def _place_variants(X_WO_place: np.ndarray, config: PlannerConfig) -> list[np.nd
     return out
 
 
+def _task_place_variants(X_WO_place: np.ndarray, config: PlannerConfig, *,
+                         placing: TaskPlacing | None, X_WO: np.ndarray, X_WG: np.ndarray,
+                         extents, is_tool: bool = False) -> list[tuple]:
+    """(R_turn, X_WO_place) to try for grasp X_WG: the task's place poses (`placing`), each
+    turned about the vertical by `config.place_yaws` (`_place_variants`). R_turn is the world
+    rotation the plan gives the object when it turns it into another resting pose (the yaw
+    included), None when its orientation is kept."""
+    if placing is None:
+        return [(None, X) for X in _place_variants(X_WO_place, config)]
+    out = []
+    for R_turn, X_place in placing.place_poses(X_WO, X_WG, extents, is_tool=is_tool,
+                                               release_height=config.release_height,
+                                               place_pose=place_pose):
+        for X in _place_variants(X_place, config):
+            turn = None if R_turn is None else X[:3, :3] @ np.asarray(X_WO)[:3, :3].T
+            out.append((turn, X))
+    return out
+
+
+def _pours(placing: TaskPlacing | None, obstacles, target: ObjectDescription,
+           X_WG: np.ndarray) -> tuple[list, str]:
+    """The pours to try for grasp X_WG (`task_motion.pour_poses`: (X_WO_pour, X_WO_tilted)),
+    [None] when the task pours nothing; ([], why) when it cannot pour."""
+    if placing is not None and placing.fill_at is not None:
+        fills = fill_poses(np.asarray(target.X_WO, float), target.extents, gate=placing.fill_at,
+                           clearance=placing.fill_clearance, yaws=placing.pour_yaws)
+        return (fills, "") if fills else ([], f"pour pose: {target_name(target)} is not upright")
+    if placing is None or placing.pour_at is None:
+        return [None], ""
+    k = bowl_of(obstacles, placing.pour_at)
+    if k is None:
+        return [], "pour pose: no object perceived to pour into"
+    bowl = obstacles[k]
+    pours = pour_poses(np.asarray(target.X_WO, float), target.extents, X_WG,
+                       bowl_xy=placing.pour_at, bowl_top=box_top(bowl.X_WO, bowl.extents),
+                       tilt=placing.pour_tilt, clearance=placing.pour_clearance,
+                       yaws=placing.pour_yaws)
+    if not pours:
+        return [], f"pour pose: {target_name(target)} is not upright"
+    return pours, ""
+
+
+def target_name(target: ObjectDescription) -> str:
+    return target.name or "the object"
+
+
 # The open finger pads in G (tg_drake.robot: pads 0.012 × 0.082 × 0.02 m centred 0.055 m along
 # +y_G, inner faces at x = ±0.055 when open): the 8 outer corners of the pair [m].
 PAD_CORNERS_G = np.array([[sx * x, y, sz * WSG_PAD_SIZE[2] / 2] for sx in (-1, 1)
@@ -404,7 +499,10 @@ def target_shapes(target: ObjectDescription) -> list[tuple]:
 PICK_POSES = {"pre-grasp", "grasp", "lift"}
 PICK_MOTIONS = ("move", "approach", "lift")
 PLACE_FAILURES = ("pre-place pose", "place pose", "retreat pose", "carry trajectory",
-                  "descend trajectory", "retreat trajectory")  # how their reasons start
+                  "descend trajectory", "retreat trajectory", "pour pose", "tilted pose",
+                  "tilt trajectory", "untilt trajectory", "return trajectory")  # how their
+# reasons start
+POUR_FAILURES = ("pour pose", "tilted pose", "tilt trajectory", "untilt trajectory")
 
 
 class _Arms:
@@ -728,9 +826,12 @@ class _KeyPoses:
     X: dict  # name → RigidTransform X_WG, in execution order
     X_GO: RigidTransform  # the target in the hand
     X_WO_place: np.ndarray  # 4×4 object pose at the place pose
+    R_turn: np.ndarray | None = None  # the object's turn into a task's resting pose
+    pour_hold: float = 0.0  # [s] held tilted (when X has "pour" and "tilted")
 
 
-def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config) -> _KeyPoses:
+def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config, *, R_turn=None, pour=None,
+               pour_hold: float = 0.0) -> _KeyPoses:
     X_WG = RigidTransform(X_WG)
     y_G = X_WG.rotation().col(1)
     up = np.array([0.0, 0.0, config.lift_height])
@@ -748,7 +849,18 @@ def _key_poses(arms: _Arms, X_WG, X_WO, X_WO_place, config) -> _KeyPoses:
          # Back out along the gripper's approach at the place (the object may have been turned
          # about the vertical there, turning the approach with it).
          "retreat": moved(X_WG_place, -config.retreat_distance * X_WG_place.rotation().col(1))}
-    return _KeyPoses(X, X_OG.inverse(), np.asarray(X_WO_place, float))
+    if R_turn is not None:
+        X["retreat"] = moved(X_WG_place, config.retreat_distance
+                             * turned_retreat(X_WG_place.rotation().col(1)))
+    if pour is not None:  # over the bowl after the lift: upright, then tilted
+        X_WO_pour, X_WO_tilted = pour
+        order = list(X)
+        at = order.index("lift") + 1
+        poses = dict(pour=RigidTransform(X_WO_pour) @ X_OG)
+        if X_WO_tilted is not None:  # pourIn holds it upright: no tilt
+            poses["tilted"] = RigidTransform(X_WO_tilted) @ X_OG
+        X = {n: (X[n] if n in X else poses[n]) for n in order[:at] + list(poses) + order[at:]}
+    return _KeyPoses(X, X_OG.inverse(), np.asarray(X_WO_place, float), R_turn, pour_hold)
 
 
 def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
@@ -761,6 +873,8 @@ def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
         "pre-grasp": (lambda: arms.free, config.min_distance),
         "grasp": (lambda: arms.grasp, config.contact_min_distance),
         "lift": (lambda: arms.carry(key.X_GO), config.min_distance),
+        "pour": (lambda: arms.carry(key.X_GO), config.min_distance),
+        "tilted": (lambda: arms.carry(key.X_GO), config.min_distance),
         "pre-place": (lambda: arms.carry(key.X_GO), config.min_distance),
         "place": (lambda: arms.carry(key.X_GO), config.contact_min_distance),
         "retreat": (lambda: arms.placed(key.X_WO_place), config.contact_min_distance),
@@ -768,6 +882,8 @@ def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
     poses: dict[str, np.ndarray] = {}
     previous = None
     for name, (make_arm, min_distance) in steps.items():
+        if name not in key.X:
+            continue
         arm = make_arm()
         step_seeds = seeds if previous is None else [previous] + seeds
         r = solve_ik_seeds(arm, key.X[name], step_seeds,
@@ -784,6 +900,16 @@ def _line(key: _KeyPoses, a: str, b: str) -> StraightLine:
     return StraightLine(key.X[a].translation(), key.X[b].translation(), key.X[a].rotation())
 
 
+def _pour_moves(carry: ArmPlant, c: PlannerConfig, *, tilt: bool) -> list[tuple]:
+    """The carrying moves of a pour: to the pour pose, tilt and tilt back (pourOut), on to the
+    pre-place."""
+    tilts = [("tilt", "pour", "tilted", carry, c.min_distance, c.carry_limits, None),
+             ("untilt", "tilted", "pour", carry, c.min_distance, c.carry_limits, None)]
+    return ([("carry", "lift", "pour", carry, c.min_distance, c.carry_limits, None)]
+            + (tilts if tilt else [])
+            + [("return", "pour", "pre-place", carry, c.min_distance, c.carry_limits, None)])
+
+
 def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *, candidate,
                   part):
     """The segments between the key configurations, assembled into a Plan: (Plan, "", True) or
@@ -797,7 +923,8 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
          _line(key, "pre-grasp", "grasp")),
         ("lift", "grasp", "lift", arms.grasp, c.contact_min_distance, c.contact_limits,
          _line(key, "grasp", "lift")),
-        ("carry", "lift", "pre-place", carry, c.min_distance, c.carry_limits, None),
+        *(_pour_moves(carry, c, tilt="tilted" in key.X) if "pour" in key.X else
+          [("carry", "lift", "pre-place", carry, c.min_distance, c.carry_limits, None)]),
         ("descend", "pre-place", "place", carry, c.contact_min_distance, c.contact_limits,
          _line(key, "pre-place", "place")),
         ("retreat", "place", "retreat", arms.placed(key.X_WO_place), c.contact_min_distance,
@@ -838,6 +965,17 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
     add_motion("lift")
     t_lift_done = t
     add_motion("carry")
+    t_pour = None
+    if "tilted" in key.X:  # tilt over the bowl, hold, tilt back, on to the place
+        add_motion("tilt")
+        t_pour = (t, t + key.pour_hold)
+        add_hold(q["tilted"], key.pour_hold)
+        add_motion("untilt")
+        add_motion("return")
+    elif "pour" in key.X:  # held under the dispenser, on to the place
+        t_pour = (t, t + key.pour_hold)
+        add_hold(q["pour"], key.pour_hold)
+        add_motion("return")
     add_motion("descend")
     t_open = t
     add_hold(q["place"], c.squeeze_duration + c.open_duration)
@@ -853,5 +991,6 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
                 t_grasp_closed=t_grasp_closed, t_lift_done=t_lift_done,
                 t_place_done=t_place_done, duration=t, candidate=candidate, part=part,
                 X_WG_grasp=key.X["grasp"].GetAsMatrix4(),
-                X_WO_place=key.X_WO_place, waypoints=q, segments=tuple(rows))
+                X_WO_place=key.X_WO_place, waypoints=q, segments=tuple(rows),
+                R_turn=key.R_turn, t_pour=t_pour)
     return plan, "", True

@@ -18,6 +18,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
 from tg_drake.planning.planner import PlannerConfig, PlanResult, plan_for_scene
+from tg_drake.planning.task_motion import TaskPlacing
 from tg_drake.robot import IIWA_HOME
 from tg_drake.scenario import Scenario
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
@@ -81,7 +82,8 @@ class GraspPlanner(LeafSystem):
     """
 
     def __init__(self, *, place_xy, start_time: float = 0.0, period: float = 0.05,
-                 config: PlannerConfig | None = None, scenario: Scenario | None = None):
+                 config: PlannerConfig | None = None, scenario: Scenario | None = None,
+                 placing: TaskPlacing | None = None, surfaces=()):
         """
         Args:
             place_xy: (2,) world xy where the target object's frame origin is placed [m].
@@ -91,6 +93,9 @@ class GraspPlanner(LeafSystem):
             config: the planner's distances, clearances, timing and limits.
             scenario: whose robot and table models the planner's arm plant uses (default: the
                 station's).
+            placing: the task's placing (`tg_drake.planning.task_motion.task_placing`); None
+                places the object at `place_xy`, its orientation kept.
+            surfaces: `tg_drake.planning.task_motion.Surface` boxes on the table (obstacles).
         """
         super().__init__()
         if len(place_xy) != 2:
@@ -100,6 +105,7 @@ class GraspPlanner(LeafSystem):
         self._place_xy = np.asarray(place_xy, float)
         self._config = config or PlannerConfig()
         self._scenario = scenario
+        self._placing, self._surfaces = placing, tuple(surfaces)
 
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
@@ -176,7 +182,8 @@ class GraspPlanner(LeafSystem):
             result = plan_for_scene(scene, grasps, place_xy=self._place_xy,
                                     q_start=memory.q_hold, config=self._config,
                                     scenario=self._scenario,
-                                    exclude_parts=tuple(request.exclude_parts), max_parts=1)
+                                    exclude_parts=tuple(request.exclude_parts), max_parts=1,
+                                    placing=self._placing, surfaces=self._surfaces)
             if result.status == "planned":
                 memory = dataclasses.replace(memory, result=result, t_plan=context.get_time())
             else:

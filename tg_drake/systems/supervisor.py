@@ -15,6 +15,10 @@ every decision that spans stages is taken here, in simulated time, from port val
 3. **Monitor**: at the plan's key times (the first check at or after each): both pads hold the
    object when the gripper has closed (else "missed"), the object rose with the gripper during the
    lift (else "slipped"), and at the end it stands let go at the place target (else "lifted").
+4. **Task check** (when the scenario gives a task): at the end, the task's judge
+   (`tg_drake.tasks.judge`) on the object's simulated pose, its contacts and the contents'
+   counts gives `Outcome.task_outcome`; a run that ended before the end of its plan gets a failed
+   task outcome saying why.
 """
 
 
@@ -24,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.math import RigidTransform
+from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import ContactResults
 from pydrake.systems.framework import EventStatus, LeafSystem
 
@@ -37,9 +41,22 @@ from tg_drake.errors import (
     SimulationError,
     TgDrakeError,
 )
-from tg_drake.outcome import HandGeometries, hand_contact, placed, touches_table
+from tg_drake.outcome import (
+    HandGeometries,
+    contact_pairs,
+    hand_contact,
+    placed,
+    touches_table,
+)
 from tg_drake.scenario import SupervisorConfig
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
+from tg_drake.tasks.judge import (
+    REST_POSE_OF_TASK,
+    judge_on_surface,
+    judge_pour,
+    judge_rest_pose,
+)
+from tg_drake.tasks.outcome import TaskOutcome
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 
@@ -90,6 +107,7 @@ class Outcome:
     reachable_parts: tuple = ()  # the part a plan was made for
     unreachable_parts: tuple = ()  # parts given to the logic as collision(Part) evidence
     requeries: int = 0  # how often the logic was asked again with new collision evidence
+    task_outcome: TaskOutcome | None = None  # the task's physical check (None: no task given)
 
     @property
     def final(self) -> bool:
@@ -99,7 +117,9 @@ class Outcome:
         """The JSON form (result.json's ``outcome``)."""
         return {"status": self.status.value, "reason": self.reason.value, "detail": self.detail,
                 "reachable_parts": list(self.reachable_parts),
-                "unreachable_parts": list(self.unreachable_parts), "requeries": self.requeries}
+                "unreachable_parts": list(self.unreachable_parts), "requeries": self.requeries,
+                "task_outcome": (self.task_outcome.as_dict() if self.task_outcome is not None
+                                 else None)}
 
 
 def outcome_of_error(error: Exception, *, pending: Outcome | None = None) -> Outcome:
@@ -110,28 +130,44 @@ def outcome_of_error(error: Exception, *, pending: Outcome | None = None) -> Out
         reason, detail = reason_of(error), str(error)
     else:
         reason, detail = Reason.simulation, f"the simulation failed: {error}"
-    return dataclasses.replace(pending, status=Status.failed, reason=reason, detail=detail)
+    task = pending.task_outcome
+    if task is not None:
+        task = TaskOutcome(task.task, False, {}, f"not done: the run failed ({reason}): {detail}")
+    return dataclasses.replace(pending, status=Status.failed, reason=reason, detail=detail,
+                               task_outcome=task)
 
 
 @dataclass(frozen=True)
 class MonitorModel:
     """What the execution monitor needs to know about the plant's model (read once, before
     simulating): the geometry ids of the target, fingers and table, the indices of the target's
-    and the gripper's bodies in ``body_poses``, and the target's box centre in its frame [m]."""
+    and the gripper's bodies in ``body_poses``, and the target's box centre in its frame [m];
+    for the task check: the table frame, whether the target is a tool, and the collision
+    geometry ids of each of the scenario's surfaces (by name; they belong to the table)."""
 
     geometries: HandGeometries
     object_body: int
     gripper_body: int
     p_OC: tuple = (0.0, 0.0, 0.0)
+    X_WT: tuple = tuple(map(tuple, np.eye(4)))  # 4×4 table frame, as nested tuples
+    is_tool: bool = False
+    surfaces: tuple = ()  # (name, frozenset of GeometryId) per surface
 
     @classmethod
     def from_plant(cls, plant, *, object_body, wsg_instance, table_instance,
-                   p_OC=(0.0, 0.0, 0.0)) -> "MonitorModel":
+                   p_OC=(0.0, 0.0, 0.0), X_WT=None, is_tool: bool = False,
+                   surfaces=()) -> "MonitorModel":
+        """`surfaces`: names of the surfaces' bodies in the table's model instance."""
+        surface_ids = tuple(
+            (name, frozenset(plant.GetCollisionGeometriesForBody(
+                plant.GetBodyByName(body, table_instance)))) for name, body in surfaces)
         return cls(HandGeometries.from_plant(plant, object_body=object_body,
                                              wsg_instance=wsg_instance,
                                              table_instance=table_instance),
                    int(object_body.index()), int(plant.GetBodyByName("body", wsg_instance).index()),
-                   tuple(float(v) for v in p_OC))
+                   tuple(float(v) for v in p_OC),
+                   tuple(map(tuple, np.eye(4) if X_WT is None else np.asarray(X_WT, float))),
+                   bool(is_tool), surface_ids)
 
 
 class Phase(enum.StrEnum):
@@ -152,10 +188,12 @@ class _Memory:
     requeries: int = 0
     failures: tuple = ()  # (part or None, reason) of every failed attempt, in order
     status: PlanStatus | None = None  # the planner's answer with the plan being executed
-    checks_passed: int = 0  # execution checks passed: 1 grasp closed, 2 lift done
+    checks_passed: int = 0  # execution checks passed: 1 grasp closed, 2 lift done, 3 the pour
+    # held over the bowl (pourOut plans only)
     z_G_grasped: float = 0.0  # [m] gripper body height when the grasp closed
     z_O_grasped: float = 0.0  # [m] object height when the grasp closed
     X_WO_picked: RigidTransform | None = None  # object pose when the plan started
+    held_at_pour: bool = False  # the gripper held the container at the end of the pour
     outcome: Outcome | None = None  # the final outcome
 
     def __deepcopy__(self, memo):
@@ -181,6 +219,7 @@ class Supervisor(LeafSystem):
         - no_hold
         - plan_request
         - outcome
+        - dispenser_command
 
     ``scene_description`` (`SceneDescription`), ``grasp_semantics`` (`GraspSemantics`) and
     ``ranked_grasps`` (`GraspCandidates`) are read at gate checks only; ``plan_status``
@@ -195,14 +234,28 @@ class Supervisor(LeafSystem):
     ``collisions`` input), ``no_hold`` (the parts on which the feasibility stage found no grasp
     that would hold, `GraspCandidates.unholdable_parts`, for the logic's ``no_hold`` input),
     ``plan_request`` (`PlanRequest`: the attempt to plan and the parts to
-    leave out, for the planner) and ``outcome`` (`Outcome`; `Outcome.final` once decided).
+    leave out, for the planner) and ``outcome`` (`Outcome`; `Outcome.final` once decided);
+    ``dispenser_command`` (1-vector: 1 opens the station's dispenser) on the state and the time.
     """
 
-    def __init__(self, *, config: SupervisorConfig | None = None, model: "MonitorModel"):
+    def __init__(self, *, config: SupervisorConfig | None = None, model: "MonitorModel",
+                 task: str = "", place_on: str = "", pour_into: str = "", container: str = "",
+                 count_contents=None, dispense_duration: float = 0.0):
+        """`task`: the scenario's given task ("" = inferred: no task check); `place_on`: the
+        surface p&pOn places the object on; `pour_into`: the instance name of the bowl
+        (pourOut); `container`: the target's instance name (pourIn's receiving vessel);
+        `count_contents`: body_poses → {place: number of spheres} (the keys of
+        `tg_drake.tasks.contents.count_contents`), None when the station has no contents;
+        `dispense_duration` [s]: pourIn opens the dispenser (``dispenser_command`` 1) this long
+        from the start of the plan's hold under it."""
         super().__init__()
         self._config = config or SupervisorConfig()
         self._config.validate()
         self._model = model
+        self._task, self._place_on = task, place_on
+        self._pour_into, self._container = pour_into, container
+        self._count_contents = count_contents
+        self._dispense_duration = float(dispense_duration)
 
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
@@ -237,6 +290,9 @@ class Supervisor(LeafSystem):
         self._outcome_port = self.DeclareAbstractOutputPort(
             "outcome", lambda: AbstractValue.Make(Outcome()), self._calc_outcome,
             prerequisites_of_calc=on_state)
+        self._dispenser_port = self.DeclareVectorOutputPort(
+            "dispenser_command", 1, self._calc_dispenser,
+            prerequisites_of_calc=on_state | {self.time_ticket()})
 
     @property
     def config(self) -> SupervisorConfig:
@@ -276,6 +332,9 @@ class Supervisor(LeafSystem):
     def get_outcome_output_port(self):
         return self._outcome_port
 
+    def get_dispenser_command_output_port(self):
+        return self._dispenser_port
+
     # The periodic check.
     def _check(self, context, state):
         memory: _Memory = context.get_abstract_state(self._memory).get_value()
@@ -296,12 +355,17 @@ class Supervisor(LeafSystem):
         return EventStatus.Succeeded()
 
     def _finish(self, memory: _Memory, status: Status, reason: Reason, detail: str,
-                **changes) -> _Memory:
+                task_outcome: TaskOutcome | None = None, **changes) -> _Memory:
         memory = dataclasses.replace(memory, **changes)
         reachable = (memory.status.part,) if memory.status is not None else ()
+        if task_outcome is None and self._task:
+            why = f"{status}" + (f" ({reason})" if reason else "")
+            task_outcome = TaskOutcome(self._task, False, {},
+                                       f"not done: the run ended {why}: {detail}")
         return dataclasses.replace(memory, phase=Phase.done, outcome=Outcome(
             status, reason, detail, reachable_parts=reachable,
-            unreachable_parts=memory.collisions, requeries=memory.requeries))
+            unreachable_parts=memory.collisions, requeries=memory.requeries,
+            task_outcome=task_outcome))
 
     def _gate(self, context, memory: _Memory) -> _Memory:
         scene: SceneDescription = self._scene_port.Eval(context)
@@ -382,7 +446,9 @@ class Supervisor(LeafSystem):
     def _monitor(self, context, memory: _Memory) -> _Memory:
         plan, t_plan = memory.status.plan, memory.status.t_plan
         t = context.get_time() - t_plan
-        key_time = (plan.t_grasp_closed, plan.t_lift_done, plan.duration)[memory.checks_passed]
+        pour = () if plan.t_pour is None else (plan.t_pour[1],)
+        key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, plan.duration)
+        key_time = key_times[memory.checks_passed]
         if t < key_time:
             return memory
         contacts = self._contacts_port.Eval(context)
@@ -407,16 +473,60 @@ class Supervisor(LeafSystem):
                                     f"the object rose {rise * 100:.1f} cm while the gripper rose "
                                     f"{gripper_rise * 100:.1f} cm")
             return dataclasses.replace(memory, checks_passed=2)
+        if memory.checks_passed == 2 and pour:  # the pour's hold is over
+            return dataclasses.replace(memory, checks_passed=3, held_at_pour=hand.held)
         # The plan is over: let go, the table carries the object (a pad may still brush it).
         if not np.all(np.isfinite(X_WO.GetAsMatrix4())):
             return self._finish(memory, Status.failed, Reason.simulation,
                                 "the simulation diverged")
         on_table = touches_table(contacts, geometries=self._model.geometries)
-        ok, detail = placed(memory.X_WO_picked, X_WO, plan.X_WO_place[:2, 3],
+        X_WO_expected = memory.X_WO_picked
+        if plan.R_turn is not None:  # the plan turns the object into another resting pose
+            X_WO_expected = RigidTransform(
+                RotationMatrix(np.asarray(plan.R_turn)) @ memory.X_WO_picked.rotation(),
+                memory.X_WO_picked.translation())
+        ok, detail = placed(X_WO_expected, X_WO, plan.X_WO_place[:2, 3],
                             released=on_table and not hand.held, p_OC=self._model.p_OC)
+        task = self._task_check(X_WO, plan, contacts, released=not hand.held, poses=poses,
+                                held_at_pour=memory.held_at_pour)
         if ok:
-            return self._finish(memory, Status.placed, Reason.none, detail)
-        return self._finish(memory, Status.lifted, Reason.slipped, detail)
+            return self._finish(memory, Status.placed, Reason.none, detail, task)
+        return self._finish(memory, Status.lifted, Reason.slipped, detail, task)
+
+    def _task_check(self, X_WO: RigidTransform, plan, contacts, *, released: bool, poses=(),
+                    held_at_pour: bool = False) -> TaskOutcome | None:
+        """The given task's judgement at the end of the plan (None when no task is given)."""
+        task, model = self._task, self._model
+        if not task:
+            return None
+        if task in REST_POSE_OF_TASK:
+            on_support = touches_table(contacts, geometries=model.geometries)
+            return judge_rest_pose(task, X_WO.GetAsMatrix4(), np.array(model.X_WT),
+                                   is_tool=model.is_tool, p_WC=X_WO.multiply(np.array(model.p_OC)),
+                                   target_xy=plan.X_WO_place[:2, 3],
+                                   released=released and on_support)
+        if task == "p&pOn":
+            surfaces = dict(model.surfaces)
+            if self._place_on not in surfaces:
+                return TaskOutcome(task, False, {}, "the scenario has no surface to place on")
+            table_top = model.geometries.table - frozenset().union(*surfaces.values())
+            on = {name: _touches(contacts, model.geometries.object, ids)
+                  for name, ids in (("surface", surfaces[self._place_on]), ("table", table_top))}
+            return judge_on_surface(self._place_on, on_surface=on["surface"],
+                                    on_table=on["table"], released=released)
+        if task in ("pourOut", "pourIn"):
+            poured = plan.t_pour is not None
+            if self._count_contents is None:
+                what = ("tilted over the bowl" if poured else
+                        "placed as for pick-and-place (no bowl: task.pour_into)")
+                return TaskOutcome(task, False, {"poured": poured},
+                                   f"{what}; the station has no contents to count "
+                                   "(`contents: {model: spheres}`)")
+            counts = self._count_contents(poses)
+            into = self._pour_into if task == "pourOut" else self._container
+            return judge_pour(task, counts, into=into, held=held_at_pour)
+        return TaskOutcome(task, False, {}, f"the {task} motion and check are not implemented "
+                           "yet: the object was placed as for pick-and-place")
 
     # Outputs.
     def _memory_of(self, context) -> _Memory:
@@ -433,6 +543,17 @@ class Supervisor(LeafSystem):
         output.set_value(PlanRequest(attempt=memory.attempt,
                                      exclude_parts=memory.collisions + memory.no_hold))
 
+    def _calc_dispenser(self, context, output):
+        """1 while a pourIn plan holds the container under the dispenser (its first
+        `dispense_duration` seconds), else 0."""
+        memory = self._memory_of(context)
+        plan = memory.status.plan if memory.status is not None else None
+        open_ = False
+        if self._task == "pourIn" and plan is not None and plan.t_pour is not None:
+            t = context.get_time() - memory.status.t_plan
+            open_ = plan.t_pour[0] <= t < plan.t_pour[0] + self._dispense_duration
+        output.SetAtIndex(0, 1.0 if open_ else 0.0)
+
     def _calc_outcome(self, context, output):
         memory = self._memory_of(context)
         if memory.outcome is not None:
@@ -441,9 +562,17 @@ class Supervisor(LeafSystem):
         waiting = {Phase.gate: "waiting for the gate check",
                    Phase.planning: f"waiting for plan attempt {memory.attempt}",
                    Phase.executing: f"executing the plan (checks passed: {memory.checks_passed})"}
+        # A run stopped now (a timeout, an error) has not done its task.
+        task = (TaskOutcome(self._task, False, {}, f"not done: {waiting[memory.phase]}")
+                if self._task else None)
         output.set_value(Outcome(Status.pending, Reason.none, waiting[memory.phase],
                                  unreachable_parts=memory.collisions,
-                                 requeries=memory.requeries))
+                                 requeries=memory.requeries, task_outcome=task))
+
+
+def _touches(contact_results, a: frozenset, b: frozenset) -> bool:
+    """Does any geometry of `a` touch one of `b` (a hydroelastic surface or a point pair)?"""
+    return any((x in a and y in b) or (y in a and x in b) for x, y in contact_pairs(contact_results))
 
 
 def _why(failures: tuple) -> str:

@@ -1,0 +1,97 @@
+"""The task judges: whether a task was done, from what physics left behind (pure functions).
+
+Each takes what the supervisor reads off the station at the end of the plan (the object's world
+pose, whether it is let go and on what it rests, where the contents' spheres are) and returns a
+`TaskOutcome` with the physical measure it was judged on:
+
+- p&pInUpright / p&pInSideways / p&pInUpsidedown (`judge_rest_pose`): let go and at rest, the
+  object's pose classified from its simulated orientation is the task's pose, its box centre
+  within `PLACE_XY_TOLERANCE` of the place target;
+- p&pOn (`judge_on_surface`): let go, resting on the named surface's geometry (not on the table);
+- pourOut / pourIn (`judge_pour`): at least `POUR_SUCCESS_FRACTION` of the spheres end in the
+  receiving vessel (the bowl; the held container for pourIn), the container still held.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tg_drake.outcome import PLACE_XY_TOLERANCE
+from tg_drake.perception.ground_truth import pose_from_transform
+from tg_drake.tasks.contents import ContentsModel, count_contents
+from tg_drake.tasks.outcome import TaskOutcome
+
+# The pose each placing task asks the object to rest in (an entry of tg_drake.types.POSES).
+REST_POSE_OF_TASK = {"p&pInUpright": "upright", "p&pInSideways": "sideways",
+                     "p&pInUpsidedown": "upsidedown"}
+# [1] share of the spheres that must end in the receiving vessel for a pour to succeed.
+POUR_SUCCESS_FRACTION = 0.8
+
+
+def rest_pose(X_WO: np.ndarray, X_WT: np.ndarray, *, is_tool: bool) -> str:
+    """The discrete pose (an entry of POSES) of an object at world pose X_WO (its library frame:
+    z along the symmetry axis towards the opening) on the table X_WT: the library's one rule,
+    `tg_drake.perception.ground_truth.pose_from_transform`."""
+    return pose_from_transform(np.asarray(X_WO, float), np.asarray(X_WT, float), is_tool)
+
+
+def judge_rest_pose(task: str, X_WO: np.ndarray, X_WT: np.ndarray, *, is_tool: bool,
+                    p_WC: np.ndarray, target_xy, released: bool) -> TaskOutcome:
+    """p&pIn*: the object at X_WO (true box centre `p_WC` in the world) rests let go
+    (`released`) in the task's pose within `PLACE_XY_TOLERANCE` of `target_xy` (world)."""
+    want = REST_POSE_OF_TASK[task]
+    got = rest_pose(X_WO, X_WT, is_tool=is_tool)
+    distance = float(np.linalg.norm(np.asarray(p_WC, float)[:2] - np.asarray(target_xy, float)))
+    measure = {"rest_pose": got, "distance_m": round(distance, 4)}
+    if not released:
+        return TaskOutcome(task, False, measure, "not let go: still held, or not resting")
+    if got != want:
+        return TaskOutcome(task, False, measure, f"rests {got}, the task asks {want}")
+    if distance > PLACE_XY_TOLERANCE:
+        return TaskOutcome(task, False, measure,
+                           f"rests {got} {distance * 100:.1f} cm from the target "
+                           f"(> {PLACE_XY_TOLERANCE * 100:.0f} cm)")
+    return TaskOutcome(task, True, measure, f"rests {got}, {distance * 100:.1f} cm from the target")
+
+
+def judge_on_surface(surface: str, *, on_surface: bool, on_table: bool,
+                     released: bool) -> TaskOutcome:
+    """p&pOn: the object let go (`released`: the gripper does not hold it) touches the surface's
+    geometry (`on_surface`) and not the table top's (`on_table`)."""
+    measure = {"surface": surface, "on_surface": bool(on_surface), "on_table": bool(on_table)}
+    if not released:
+        return TaskOutcome("p&pOn", False, measure, "not let go: still held")
+    if not on_surface:
+        where = "on the table" if on_table else "on neither the surface nor the table"
+        return TaskOutcome("p&pOn", False, measure, f"not on {surface}: {where}")
+    if on_table:
+        return TaskOutcome("p&pOn", False, measure,
+                           f"touches both {surface} and the table (hanging over its edge)")
+    return TaskOutcome("p&pOn", True, measure, f"resting on {surface}")
+
+
+def judge_pour(task: str, counts: dict, *, into: str, held: bool) -> TaskOutcome:
+    """pourOut / pourIn: `counts` (where every sphere is: `tg_drake.tasks.contents.
+    count_contents`'s keys and counts) has at least `POUR_SUCCESS_FRACTION` of them in `into`
+    (the bowl for pourOut, the held container for pourIn), and the container is still `held`."""
+    total = int(sum(counts.values()))
+    inside = int(counts.get(into, 0))
+    fraction = inside / total if total else 0.0
+    measure = {"poured_fraction": round(fraction, 4), "into": into, "counts": dict(counts)}
+    if total == 0:
+        return TaskOutcome(task, False, measure, "no contents to pour")
+    if not held:
+        return TaskOutcome(task, False, measure, "the container was not held to the end")
+    ok = fraction >= POUR_SUCCESS_FRACTION
+    return TaskOutcome(task, ok, measure,
+                       f"{inside} of {total} spheres ({fraction:.0%}) in {into}"
+                       + ("" if ok else f" (< {POUR_SUCCESS_FRACTION:.0%})"))
+
+
+def contents_counter(model: ContentsModel, *, containers: dict, table_z: float):
+    """body_poses → where the spheres of `model` are (`count_contents`), the containers given as
+    name → (index of its body in body_poses, LibraryObject) [table_z: m, world]."""
+    def count(body_poses) -> dict:
+        return count_contents(model, body_poses, table_z=table_z, containers={
+            name: (body_poses[index], obj) for name, (index, obj) in containers.items()})
+    return count
