@@ -4,10 +4,10 @@ Every `import` and `from ... import` statement in tg_drake/ is read with `ast`, 
 (module level, inside functions or methods, under `if TYPE_CHECKING:`), and resolved to an
 absolute module name. Two rules:
 
-1. The cores (tg_drake.perception, kernels, logic, grasping, planning, importing, tasks) import neither the Drake
-   systems framework (pydrake.systems.*), the simulation (tg_drake.station, tg_drake.simulation),
-   the systems (tg_drake.systems), evaluation (tg_drake.evaluation, tg_drake.executor) nor the
-   application (tg_drake.run, cli, diagram, render).
+1. The cores (tg_drake.perception, kernels, logic, grasping, planning, importing, tasks) import
+   neither the Drake systems framework (pydrake.systems.*), the simulation (tg_drake.station,
+   tg_drake.simulation), the systems (tg_drake.systems), evaluation (tg_drake.evaluation,
+   tg_drake.executor) nor the application (tg_drake.run, cli, diagram, render).
 2. There is no import cycle between the units of tg_drake, a unit being one entry of the package's
    top level: a subpackage (tg_drake.perception with everything below it) or a module
    (tg_drake.station). Nor is there a cycle between the modules inside a subpackage.

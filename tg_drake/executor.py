@@ -17,7 +17,8 @@ One interface for every sweep (grasp-data collection, scenario evaluation):
   the sweep. The records of a job that ran more than once (its worker died under it) carry
   "attempts": the number of times it was started.
 - Every record says where and how long it ran: `worker_pid`, `rss_mb` (the worker's peak resident
-  memory so far [MB]) and `wall_s` (the job's wall time [s]). What a job writes besides its result — Python warnings, log records (Drake's C++ log
+  memory so far [MB]) and `wall_s` (the job's wall time [s]). What a job writes besides its
+  result — Python warnings, log records (Drake's C++ log
   lines reach Python's `logging`), and, in a pool or Ray worker, anything written to its stdout or
   stderr by native code — is captured per job and kept in the record's "log" (a list of lines);
   with the progress bar, each distinct line is also printed above the bar (tqdm.write), so the

@@ -8,7 +8,7 @@ default camera's viewpoint and measured by the scenario default's depth sensor
 the cue that decided it — the true poses are counted; `tg_drake.perception.pose.PoseCalibration`
 turns the counts into P(true pose | decision, cue).
 
-    .venv/bin/python tools/calibrate_pose.py                   # → tg_drake/data/pose_likelihood.json
+    .venv/bin/python tools/calibrate_pose.py  # → tg_drake/data/pose_likelihood.json
     .venv/bin/python tools/calibrate_pose.py --sensor ideal --out /tmp/pose.json
 """
 

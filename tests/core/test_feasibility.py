@@ -64,7 +64,7 @@ def test_a_box_wider_than_the_opening_is_cut_by_the_open_pads():
 
 
 def test_the_approach_sweep_and_a_neighbour_in_the_closing_pads():
-    target = box_surface((0.04, 0.03, 0.06), centre=(0, 0, 0.03))
+    box_surface((0.04, 0.03, 0.06), centre=(0, 0, 0.03))
     X = top_down((0, 0, 0.04))
     # Something 35 mm above the housing's back (at 0.1525 m), in the gripper's way down.
     above = box_surface((0.01, 0.01, 0.01), centre=(0.06, 0, 0.19))
@@ -81,7 +81,7 @@ def test_the_approach_sweep_and_a_neighbour_in_the_closing_pads():
 
 
 def test_the_table_under_the_pads():
-    target = box_surface((0.04, 0.03, 0.06), centre=(0, 0, 0.03))
+    box_surface((0.04, 0.03, 0.06), centre=(0, 0, 0.03))
     X = top_down((0, 0, 0.03))  # the pads' tips reach 41 mm below the grasp point
     c = collision(X, others_p_W=np.zeros((0, 3)), table_z=0.0,
                   approach=0.1, config=CONFIG)

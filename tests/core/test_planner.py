@@ -8,8 +8,8 @@ import pytest
 from grasp_helpers import GRASP_POINT, grasp_pose
 from pydrake.math import RigidTransform, RotationMatrix
 
-from tg_drake.planning.ik import CONSTRAINT_TOLERANCE, clearance, make_arm_plant, solve_ik_seeds
 from tg_drake.grasping import feasibility
+from tg_drake.planning.ik import CONSTRAINT_TOLERANCE, clearance, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.planner import (
     TABLE_CLEARANCE,
     PlannerConfig,

@@ -16,7 +16,8 @@ fingers close along ±x_G, approach along +y_G, z_G across the pads):
     (tg_drake.robot.WSG_PAD_FRICTION and the object's), the normal force (the grip, capped by the
     WSG's force limit), the object's mass (its perceived convex-hull volume × a density per
     category — the training objects' mass / hull volume, shipped with the hold model — weighted by
-    the logic's category distribution) and the lever of its weight about the closing axis give the wrench the patches must carry under the lift and carry
+    the logic's category distribution) and the lever of its weight about the closing axis give
+    the wrench the patches must carry under the lift and carry
     accelerations and the wrench they can carry: a translational, a torsional and a combined
     margin (elliptic limit surface: margin < 1 slips).
 (c) P(hold | features) — a logistic regression on the margins and patch features, fitted on
@@ -77,7 +78,11 @@ class FeasibilityConfig:
     default_density: float = 500.0  # [kg/m³] of convex-hull volume, when no category
     # distribution is given (the hold model's per-category densities otherwise).
     min_p_hold: float = 0.5  # a candidate more likely to slip than to hold (P(hold) below this)
-    # gets score 0, "would not hold".
+    # gets score 0, "would not hold" (with `rank_by_hold`).
+    rank_by_hold: bool = False  # multiply the score by P(hold) and refuse below min_p_hold. Off:
+    # the shipped hold model (211 episodes of 13 training objects) predicts no better than the
+    # base rate on held-out objects (Brier 0.246 against 0.250, tg_drake/data/
+    # hold_model.report.json), so it is reported (result.json grasp.p_hold), not acted on.
     model: str = ""  # a hold-model JSON file (tools/fit_hold_model.py); "" = the shipped one.
     approach_tilts: list[float] = field(default_factory=lambda: [10.0, 20.0, 35.0])  # [deg] a
     # side grasp (approach within 30° of horizontal) is also offered tilted downwards about its
@@ -429,7 +434,7 @@ def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: n
             continue
         ph = float(model.predict_proba(h.features())[0])
         p.append(ph)
-        reasons.append("" if ph >= config.min_p_hold else
+        reasons.append("" if ph >= config.min_p_hold or not config.rank_by_hold else
                        f"would not hold: P(hold) {ph:.2f} (margin {h.margin:.2f}, patch "
                        f"{h.patch_area * 1e6:.0f} mm², lever {h.lever * 1000:.0f} mm, "
                        f"mass {h.mass:.2f} kg)")
@@ -532,7 +537,7 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
     p_local = np.asarray(candidates.p_local, float)[source]
     parts = np.asarray(candidates.parts, int)[source]
     ok = np.array([not r for r in f.reasons], bool)
-    score = np.where(ok, p_part * p_local * f.p_hold, 0.0)
+    score = np.where(ok, p_part * p_local * (f.p_hold if config.rank_by_hold else 1.0), 0.0)
     order = np.argsort(-score, kind="stable")
     # Parts the logic and the shape allow, none of whose poses would hold (not for collisions).
     viable = p_part * p_local > 0

@@ -3,7 +3,8 @@
 `Observations` holds what perception, the kernel prior, the user and the planner say about the
 object under query: probabilistic parts, the pose likelihood, containment, the category prior (an
 annotated disjunction, or uniform), the given task or a task prior, collision(Part) evidence
-(unreachable parts), no_hold(Part) evidence (parts on which no grasp would hold), the handle count, and whether the object's inside was seen through a wide opening (`interior_seen`,
+(unreachable parts), no_hold(Part) evidence (parts on which no grasp would hold), the handle
+count, and whether the object's inside was seen through a wide opening (`interior_seen`,
 ours: the paper's parts cannot tell a glass from a can of the same shape; an open top can).
 It is validated on construction; bad input raises `RuleError` naming the field and the allowed
 values.

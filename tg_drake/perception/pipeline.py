@@ -78,7 +78,8 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
     return ObjectDescription(
         p_W=transform(X_WT, c.p_T), n_W=rotate(X_WT, c.n_T), labels=parts.labels,
         visible=c.visible, X_WO=X_WO, extents=parts.extents, pose=pose.pose,
-        pose_likelihood=pose.likelihood, pose_cue=pose.cue, part_probabilities=parts.probabilities, part_boxes=boxes,
+        pose_likelihood=pose.likelihood, pose_cue=pose.cue,
+        part_probabilities=parts.probabilities, part_boxes=boxes,
         pregrasp_X_WG=X_WG, pregrasp_parts=grasp_parts, containment=None, is_tool=parts.is_tool,
         interior_seen=interior_seen(pose, parts.is_tool, cfg.pose))
 

@@ -207,7 +207,7 @@ class TaskPlacing:
     @property
     def hold(self) -> float:
         """[s] how long the container is held at the pour (tilted) or under the dispenser."""
-        return self.fill_open + self.fill_settle if self.fill_at is not None else self.pour_hold  # the surface's name (p&pOn), else ""
+        return self.fill_open + self.fill_settle if self.fill_at is not None else self.pour_hold
 
     def place_poses(self, X_WO: np.ndarray, X_WG: np.ndarray, extents, *, is_tool: bool,
                     release_height: float, place_pose) -> list[tuple]:

@@ -572,7 +572,8 @@ class Supervisor(LeafSystem):
 
 def _touches(contact_results, a: frozenset, b: frozenset) -> bool:
     """Does any geometry of `a` touch one of `b` (a hydroelastic surface or a point pair)?"""
-    return any((x in a and y in b) or (y in a and x in b) for x, y in contact_pairs(contact_results))
+    return any((x in a and y in b) or (y in a and x in b)
+               for x, y in contact_pairs(contact_results))
 
 
 def _why(failures: tuple) -> str:
