@@ -167,3 +167,11 @@ def test_bad_executor_options_are_refused_before_any_work(options, message, tmp_
     assert eval_(TINY, "--out", tmp_path, *options) == 2
     assert message.format(port=port) in capsys.readouterr().err
     assert not (tmp_path / "results.jsonl").exists()
+
+
+def test_the_bar_counts_an_executed_case_by_its_outcome_and_others_as_done():
+    from tg_drake.evaluation.cli import outcome_label
+
+    assert outcome_label([{"outcome": {"status": "placed", "reason": ""}}]) == "placed"
+    assert outcome_label([{"outcome": {"status": "failed", "reason": "missed"}}]) == "failed"
+    assert outcome_label([{"methods": {}}, {"methods": {}}]) == "done"  # perceived: 2 settings

@@ -110,7 +110,7 @@ def results_files(out_dir: Path, extra: list[Path] = ()) -> list[Path]:
             found += [f for f in [p / "results.jsonl", *sorted(p.glob(SHARD_GLOB))] if f.is_file()]
         elif p.exists():
             found.append(p)
-        else:
+        elif p is not out_dir:  # DIR itself may not exist yet: no records
             raise ScenarioError("no such results file or folder", file=str(p), field="--merge")
     unique = []
     for f in found:
