@@ -49,7 +49,7 @@ import numpy as np
 from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
-from tg_drake.grasping.feasibility import GRASP_DEPTH  # noqa: F401  (scripted.py reads it here)
+from tg_drake.grasping.feasibility import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.task_motion import (
     TaskPlacing,

@@ -20,10 +20,10 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from tg_drake.bench import Figure
 from tg_drake.errors import PlanningError, SimulationError
+from tg_drake.grasping.feasibility import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.objects import get_object
 from tg_drake.outcome import CLOSED_ON_AIR
 from tg_drake.planning.ik import make_arm_plant, solve_ik
-from tg_drake.planning.planner import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.robot import IIWA_HOME, WSG_BODY, WSG_MAX_OPENING
 from tg_drake.scenario import InverseDynamicsDriver, ObjectPlacement, Scenario
 from tg_drake.station import add_station, rotation_from_axes
