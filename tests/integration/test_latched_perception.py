@@ -37,7 +37,7 @@ def evaluate(pipeline, context, name, system):
 
 def stages(pipeline, context):
     return (evaluate(pipeline, context, "grasp_semantics", pipeline.logic),
-            evaluate(pipeline, context, "ranked_grasps", pipeline.scoring))
+            evaluate(pipeline, context, "ranked_grasps", pipeline.feasibility))
 
 
 def depth(pipeline, context) -> np.ndarray:

@@ -49,8 +49,10 @@ def check_result_keys(result: dict) -> None:
         g = result["grasp"]
         assert len(g["xyz"]) == 3 and len(g["rpy"]) == 3
         assert g["part"] in PART_LABELS
-        # The executed pose's score: P(part | task) · P(grasp | local shape) · P(hold).
-        p_hold = 1.0 if g.get("p_hold") is None else g["p_hold"]
+        # The executed pose's score: P(part | task) · P(grasp | local shape), times P(hold) when
+        # the feasibility stage ranks by it (P(hold) is reported either way).
+        ranked_by_hold = result["config"]["pipeline"]["feasibility"]["rank_by_hold"]
+        p_hold = g["p_hold"] if ranked_by_hold and g.get("p_hold") is not None else 1.0
         assert g["score"] == pytest.approx(g["p_part"] * g["p_local"] * p_hold, rel=1e-6)
     assert all(v >= 0 for v in result["timings"].values())
 

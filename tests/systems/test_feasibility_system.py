@@ -60,9 +60,11 @@ def candidates():
                            np.array([0.9, 0.8]), np.array([0.9, 0.8]), target=0)
 
 
-def test_feasibility_system_rules_out_the_pose_that_would_cut_a_neighbour(scene):
+@pytest.mark.parametrize("rank_by_hold", [False, True])
+def test_feasibility_system_rules_out_the_pose_that_would_cut_a_neighbour(scene, rank_by_hold):
     builder = DiagramBuilder()
-    system = builder.AddSystem(GraspFeasibility(FeasibilityConfig(), approach=0.1))
+    config = FeasibilityConfig(rank_by_hold=rank_by_hold, min_p_hold=0.0)
+    system = builder.AddSystem(GraspFeasibility(config, approach=0.1))
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     sc = system.GetMyContextFromRoot(context)
@@ -79,9 +81,11 @@ def test_feasibility_system_rules_out_the_pose_that_would_cut_a_neighbour(scene)
     assert np.all(out.score[along] == 0.0)
     assert all(r.startswith("collision") for r, a in zip(out.feasibility_reasons, along,
                                                           strict=True) if a)
-    # The pose across y clears the neighbour; its score is the product of the three factors.
+    # The pose across y clears the neighbour; its score is the product of the factors, P(hold)
+    # among them when the stage ranks by it.
     best = int(np.argmax(out.score))
     assert out.source[best] == 1
-    assert out.score[best] == pytest.approx(1.0 * 0.8 * out.p_hold[best])
+    p_hold = out.p_hold[best] if rank_by_hold else 1.0
+    assert out.score[best] == pytest.approx(1.0 * 0.8 * p_hold)
     assert 0.0 < out.p_hold[best] <= 1.0
     assert np.all(np.diff(out.score) <= 0)  # best first
