@@ -600,3 +600,41 @@ def test_an_open_pad_coming_down_on_the_object_is_refused():
     # the check is for tools lying on the table only.
     o.is_tool = False
     assert "come down on the object" not in _refusal(o, "usable_area", X, None, config)
+
+
+def test_a_straight_move_onto_another_ik_branch_has_its_start_solved_again(monkeypatch):
+    """The grasp's IK (seeded by the pre-grasp's) lands on a flipped wrist: the pre-grasp is
+    solved again from the grasp's configuration, so the 10 cm approach is not a wrist flip."""
+    from tg_drake.planning import planner
+    from tg_drake.planning.ik import IkResult
+
+    flipped = np.array([0.0, 0.3, 0.0, -1.2, -2.6, -2.0, 3.1])
+    calls = []
+
+    def fake_ik(arm, X_WG, seeds, **kwargs):
+        name = next(n for n, X in key.X.items() if X is X_WG)
+        calls.append((name, np.array(seeds[0])))
+        if name == "grasp":
+            return IkResult(True, flipped.copy(), 0.0)
+        return IkResult(True, np.asarray(seeds[0], float) + 0.01, 0.0)  # near its first seed
+
+    class Arms:
+        free = grasp = "arm"
+
+        def carry(self, X_GO):
+            return "arm"
+
+        def placed(self, X_WO):
+            return "arm"
+
+    monkeypatch.setattr(planner, "solve_ik_seeds", fake_ik)
+    names = ("pre-grasp", "grasp", "lift", "pre-place", "place", "retreat")
+    key = planner._KeyPoses({n: RigidTransform([0.5, 0.0, 0.1 + 0.01 * k])
+                             for k, n in enumerate(names)}, RigidTransform(), np.eye(4))
+    poses, failure = planner._waypoint_configurations(Arms(), key, [np.zeros(7)],
+                                                      PlannerConfig())
+    assert failure == ""
+    assert [c[0] for c in calls] == ["pre-grasp", "grasp", "pre-grasp", "lift", "pre-place",
+                                     "place", "retreat"]
+    assert np.max(np.abs(poses["grasp"] - poses["pre-grasp"])) < planner.BRANCH_JUMP
+    np.testing.assert_allclose(poses["pre-grasp"], flipped + 0.01)

@@ -892,8 +892,32 @@ def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
         if not r.success:
             return poses, f"{name} pose unreachable ({r.reason})"
         poses[name] = r.q
+        start = ENTERED_FREE.get(name)
+        if start in poses and _jump(r.q, poses[start]) > BRANCH_JUMP:
+            # The straight move's end is on another IK branch than its start: solve the start
+            # again from the end's configuration, and let the free move before it make the turn.
+            make_start, start_distance = steps[start]
+            again = solve_ik_seeds(make_start(), key.X[start], [r.q],
+                                   position_tolerance=config.ik_position_tolerance,
+                                   angle_tolerance=config.ik_angle_tolerance,
+                                   min_distance=start_distance)
+            if again.success and _jump(r.q, again.q) < _jump(r.q, poses[start]):
+                poses[start] = again.q
         previous = r.q
     return poses, ""
+
+
+# The straight moves that a free move leads into (end → start): a branch change between their two
+# configurations is made up by solving the start again (`_waypoint_configurations`).
+ENTERED_FREE = {"grasp": "pre-grasp", "place": "pre-place"}
+BRANCH_JUMP = np.pi / 2  # [rad] a joint turning more than this between the two ends of a 10 cm
+# straight move is on another branch of the inverse kinematics (a wrist flip turns joints 5–7 by
+# about π); the straight move through it then takes many seconds at the contact speed limits.
+
+
+def _jump(q_a: np.ndarray, q_b: np.ndarray) -> float:
+    """[rad] the largest joint change between two iiwa configurations."""
+    return float(np.max(np.abs(np.asarray(q_a) - np.asarray(q_b))))
 
 
 def _line(key: _KeyPoses, a: str, b: str) -> StraightLine:
