@@ -297,7 +297,7 @@ def summary(result: dict) -> str:
         g = result["grasp"]
         lines.append(f"grasp      part {g['part']}, xyz {g['xyz']}, score {g['score']:.3f} "
                      f"(P(part|task) {g['p_part']:.2f} × P(grasp|shape) {g['p_local']:.2f}"
-                     f"{_hold_text(g)})")
+                     f"{_hold_text(g, result)})")
     status = o["status"] + (f" ({o['reason']})" if o["reason"] else "")
     lines.append(f"outcome    {status}: {o['detail']}")
     if result.get("task_outcome"):
@@ -316,5 +316,12 @@ def summary(result: dict) -> str:
     return "\n".join(lines)
 
 
-def _hold_text(g: dict) -> str:
-    return f" × P(hold) {g['p_hold']:.2f}" if g.get("p_hold") is not None else ""
+def _hold_text(g: dict, result: dict) -> str:
+    """P(hold)'s place in the summary: a factor of the score when the feasibility stage ranks by
+    it, else beside it (reported, not used)."""
+    if g.get("p_hold") is None:
+        return ""
+    feasibility = result.get("config", {}).get("pipeline", {}).get("feasibility", {})
+    if feasibility.get("rank_by_hold", False):
+        return f" × P(hold) {g['p_hold']:.2f}"
+    return f"; P(hold) {g['p_hold']:.2f}, not ranked by"

@@ -66,6 +66,10 @@ def test_default_scenario_passes_the_cup_by_its_middle(cached_run):
     assert result["grasp"]["part"] == "middle"
     assert result["outcome"]["status"] == "placed", result["outcome"]
     assert "cup" in summary(result) and "placed" in summary(result)
+    # P(hold) is reported beside the score, not as its factor, while the stage does not rank by it.
+    assert not result["config"]["pipeline"]["feasibility"]["rank_by_hold"]
+    grasp_line = next(line for line in summary(result).splitlines() if line.startswith("grasp"))
+    assert "not ranked by" in grasp_line and "× P(hold)" not in grasp_line
     # What the run used is what it reports: planning done, no collision evidence, and the full
     # resolved configuration (the supervisor's settings included).
     assert result["planning"]["status"] == "done"
