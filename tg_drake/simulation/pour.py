@@ -27,13 +27,11 @@ from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 from tg_drake.bench import Figure
-from tg_drake.errors import PlanningError
 from tg_drake.models import make_parser
 from tg_drake.objects import WATER_DENSITY, get_object, mesh
-from tg_drake.planning.ik import make_arm_plant, solve_ik
-from tg_drake.robot import IIWA_HOME, WSG_MAX_OPENING
+from tg_drake.robot import WSG_MAX_OPENING
 from tg_drake.scenario import ObjectPlacement, Scenario, default_plant_config
-from tg_drake.simulation.scripted import side_grasp_pose
+from tg_drake.simulation.scripted import side_grasp_configurations
 from tg_drake.station import add_spheres, add_station
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, add_table
 from tg_drake.tasks.contents import ContentsConfig, ContentsModel, container_sites, count_contents
@@ -110,20 +108,7 @@ def scripted_pour(scenario: Scenario, *, object_name: str, p_W_grasp, tilt: floa
     builder = DiagramBuilder()
     station = add_station(builder, scenario=scenario)
     plant = station.plant
-    p = np.asarray(p_W_grasp, float)
-    approach = np.array([p[0], p[1], 0.0])
-    X_grasp = side_grasp_pose(p, approach, pitch=pitch)
-    y_G = X_grasp.rotation().col(1)
-    X_pre = RigidTransform(X_grasp.rotation(), X_grasp.translation() - 0.10 * y_G)
-    X_lift = RigidTransform(X_grasp.rotation(), X_grasp.translation() + [0, 0, lift])
-    arm = make_arm_plant(scenario)
-    qs = [np.asarray(IIWA_HOME)]
-    for name, X, min_distance in (("pre-grasp", X_pre, 0.005), ("grasp", X_grasp, None),
-                                  ("lift", X_lift, None)):
-        r = solve_ik(arm, X, q_seed=qs[-1], min_distance=min_distance)
-        if not r.success:
-            raise PlanningError(f"{name} pose unreachable: {r.reason}")
-        qs.append(r.q)
+    qs = side_grasp_configurations(scenario, p_W_grasp, lift=lift, pitch=pitch)
     q_tilt = qs[3].copy()
     q_tilt[6] += tilt
     # Timeline [s]: approach, move in, close, lift, tilt, hold.

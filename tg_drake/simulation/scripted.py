@@ -54,19 +54,14 @@ def side_grasp_pose(p_WO_center, approach_W=(1.0, 0.0, 0.0), *, pitch: float = 0
     return RigidTransform(R_WG, np.asarray(p_WO_center) - GRASP_DEPTH * approach)
 
 
-def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: float = 0.10,
-                   pitch: float = np.deg2rad(30), render: bool = True,
-                   width_closed: float = 0.0) -> GraspLiftResult:
-    """Runs the scripted grasp-and-lift on `object_name`, grasping at world point `p_W_grasp`."""
-    builder = DiagramBuilder()
-    station = add_station(builder, scenario=scenario)
-    plant = station.plant
-
-    # Key poses of the gripper, then joint positions by IK on a kinematic arm model.
+def side_grasp_configurations(scenario: Scenario, p_W_grasp, *, lift: float, pitch: float
+                              ) -> list[np.ndarray]:
+    """The iiwa configurations of a scripted side grasp at world point `p_W_grasp`, approached
+    horizontally from the robot's side: [home, pre-grasp (10 cm back), grasp, lift (`lift` [m]
+    up)], by IK on a kinematic arm model, each seeded by the one before; PlanningError naming
+    the pose that is out of reach."""
     p = np.asarray(p_W_grasp, float)
-    approach = p - np.array([0.0, 0.0, p[2]])
-    approach[2] = 0.0
-    X_grasp = side_grasp_pose(p, approach, pitch=pitch)
+    X_grasp = side_grasp_pose(p, np.array([p[0], p[1], 0.0]), pitch=pitch)
     y_G = X_grasp.rotation().col(1)
     X_pre = RigidTransform(X_grasp.rotation(), X_grasp.translation() - 0.10 * y_G)
     X_lift = RigidTransform(X_grasp.rotation(), X_grasp.translation() + [0, 0, lift])
@@ -78,6 +73,18 @@ def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: flo
         if not r.success:
             raise PlanningError(f"{name} pose unreachable: {r.reason}")
         qs.append(r.q)
+    return qs
+
+
+def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: float = 0.10,
+                   pitch: float = np.deg2rad(30), render: bool = True,
+                   width_closed: float = 0.0) -> GraspLiftResult:
+    """Runs the scripted grasp-and-lift on `object_name`, grasping at world point `p_W_grasp`."""
+    builder = DiagramBuilder()
+    station = add_station(builder, scenario=scenario)
+    plant = station.plant
+
+    qs = side_grasp_configurations(scenario, p_W_grasp, lift=lift, pitch=pitch)
 
     # Timeline [s]: approach, move in, close, lift, hold.
     times = [0.0, 2.0, 3.0, 4.0, 5.5, 6.5]
