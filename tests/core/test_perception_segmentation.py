@@ -136,3 +136,17 @@ def test_config_is_used():
     cfg = PerceptionConfig(segmentation=SegmentationConfig(min_cluster_points=100000))
     assert describe_scene(depth, K, X, cfg).objects == []
     assert len(describe_scene(depth, K, X).objects) == 1
+
+
+def test_ransac_plane_finds_the_largest_plane_and_repeats_itself():
+    from tg_drake.perception.segmentation import ransac_plane
+    rng = np.random.default_rng(0)
+    table = np.column_stack([rng.uniform(-0.5, 0.5, (4000, 2)), rng.normal(0.0, 0.002, 4000)])
+    wall = np.column_stack([rng.uniform(-0.5, 0.5, 1000), np.full(1000, 0.3),
+                            rng.uniform(0.0, 0.4, 1000)])
+    p = np.vstack([table, wall])
+    n, d = ransac_plane(p, 0.005, 300, np.random.default_rng(7))
+    assert abs(n[2]) > 0.999 and abs(d) < 0.002  # the table, not the wall
+    again = ransac_plane(p, 0.005, 300, np.random.default_rng(7))
+    np.testing.assert_array_equal(n, again[0])
+    assert d == again[1]

@@ -34,9 +34,9 @@ class SegmentationConfig:
     merge_max_gap: float = 0.05  # clusters touching in the image this close in depth merge [m].
     border_margin_px: int = 2  # a cluster with a pixel this close to the image edge is cut [px].
     drop_border_objects: bool = True  # drop objects cut by the image border (else keep them).
-    seed: int = 0  # seeds the table's RANSAC (Open3D's generator is set from it before each
-    # table search; the only randomness of the perception stage: DBSCAN is deterministic). In a
-    # scenario the RANSAC seed is this plus the scenario's random_seed.
+    seed: int = 0  # seeds the table's RANSAC (a generator made from it for each table search;
+    # the only randomness of the perception stage: DBSCAN is deterministic). In a scenario the
+    # RANSAC seed is this plus the scenario's random_seed.
 
 
 @dataclass

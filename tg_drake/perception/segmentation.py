@@ -1,10 +1,10 @@
 """Table plane and object clusters from a depth cloud (the paper's table-top segmentation step).
 
-The table is the largest horizontal plane found by RANSAC (Open3D `segment_plane`), refitted by
-least squares on its inliers. The table frame T has its origin at the inliers' centroid on the
-plane, z along the plane normal (towards the camera, i.e. up) and x along the inliers' principal
-direction. Object points are the points above the plane, inside the table's extent; they are
-averaged per voxel and clustered with DBSCAN (Open3D `cluster_dbscan`). Two clusters that touch
+The table is the largest horizontal plane found by RANSAC (`ransac_plane`, seeded: the same
+plane on every run), refitted by least squares on its inliers. The table frame T has its origin
+at the inliers' centroid on the plane, z along the plane normal (towards the camera, i.e. up)
+and x along the inliers' principal direction. Object points are the points above the plane,
+inside the table's extent; they are averaged per voxel and clustered with DBSCAN (Open3D `cluster_dbscan`). Two clusters that touch
 in the image with a short depth step between them are one object whose connection the nearer
 part hides: a pan's handle whose root hides behind the rim. A cluster with a pixel on the image
 border is cut: by default it is dropped, since no completion can recover what the image does
@@ -56,6 +56,27 @@ def _fit_plane(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return c, vt[2]
 
 
+def ransac_plane(p: np.ndarray, distance: float, iterations: int, rng: np.random.Generator
+                 ) -> tuple[np.ndarray, float]:
+    """(n, d) of the plane n·p + d = 0 (|n| = 1) through three of the points `p` (N, 3) that has
+    the most points within `distance` [m], over `iterations` samples drawn from `rng` (the first
+    such plane on a tie). The same generator state gives the same plane on every run: Open3D's
+    `segment_plane` spreads its iterations over threads and does not draw the same samples from
+    run to run whatever its seed, which on a noisy table moved points across the table's height
+    threshold."""
+    triples = p[rng.integers(0, len(p), size=(iterations, 3))]
+    normals = np.cross(triples[:, 1] - triples[:, 0], triples[:, 2] - triples[:, 0])
+    norms = np.linalg.norm(normals, axis=1)
+    usable = norms > 1e-12  # three distinct, non-collinear points
+    normals[usable] /= norms[usable, None]
+    offsets = -np.einsum("ij,ij->i", normals, triples[:, 0])
+    counts = np.zeros(iterations, int)
+    for k in np.flatnonzero(usable):
+        counts[k] = np.count_nonzero(np.abs(dot3(p, normals[k]) + offsets[k]) < distance)
+    best = int(np.argmax(counts))
+    return normals[best], float(offsets[best])
+
+
 def find_table(p_W: np.ndarray, p_WC: np.ndarray, cfg: SegmentationConfig
                ) -> tuple[np.ndarray, np.ndarray, list[float]]:
     """The table plane of a world-frame cloud.
@@ -63,7 +84,7 @@ def find_table(p_W: np.ndarray, p_WC: np.ndarray, cfg: SegmentationConfig
     Returns the plane point c_W, its unit normal n_W (towards the camera) and the tilt of every
     plane tried [deg]. Raises PerceptionError when no horizontal plane holds enough points.
     """
-    o3d.utility.random.seed(cfg.seed)
+    rng = np.random.default_rng(cfg.seed)
     remaining = p_W
     tilts = []
     cos_max = np.cos(np.radians(cfg.max_table_tilt_deg))
@@ -72,11 +93,7 @@ def find_table(p_W: np.ndarray, p_WC: np.ndarray, cfg: SegmentationConfig
         if len(remaining) < max(3, need):
             break
         stride = max(1, len(remaining) // cfg.ransac_points)
-        sub = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(remaining[::stride]))
-        (a, b, c, d), _ = sub.segment_plane(cfg.plane_distance, 3, cfg.ransac_iterations)
-        n = np.array([a, b, c])
-        scale = np.linalg.norm(n)
-        n, d = n / scale, d / scale
+        n, d = ransac_plane(remaining[::stride], cfg.plane_distance, cfg.ransac_iterations, rng)
         if n @ p_WC + d < 0:  # point the normal to the camera's side.
             n, d = -n, -d
         inliers = np.abs(dot3(remaining, n) + d) < cfg.plane_distance
