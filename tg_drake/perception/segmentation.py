@@ -1,14 +1,14 @@
 """Table plane and object clusters from a depth cloud (the paper's table-top segmentation step).
 
-The table is the largest horizontal plane found by RANSAC (`ransac_plane`, seeded: the same
-plane on every run), refitted by least squares on its inliers. The table frame T has its origin
-at the inliers' centroid on the plane, z along the plane normal (towards the camera, i.e. up)
-and x along the inliers' principal direction. Object points are the points above the plane,
-inside the table's extent; they are averaged per voxel and clustered with DBSCAN (Open3D `cluster_dbscan`). Two clusters that touch
-in the image with a short depth step between them are one object whose connection the nearer
-part hides: a pan's handle whose root hides behind the rim. A cluster with a pixel on the image
-border is cut: by default it is dropped, since no completion can recover what the image does
-not hold.
+The table is the largest horizontal plane found by RANSAC (`ransac_plane`, seeded: the same plane on
+every run), refitted by least squares on its inliers. The table frame T has its origin at the
+inliers' centroid on the plane, z along the plane normal (towards the camera, i.e. up) and x along
+the inliers' principal direction. Object points are the points above the plane, inside the table's
+extent; they are averaged per voxel and clustered with DBSCAN (Open3D `cluster_dbscan`). Two
+clusters that touch in the image with a short depth step between them are one object whose
+connection the nearer part hides: a pan's handle whose root hides behind the rim. A cluster with a
+pixel on the image border is cut: by default it is dropped, since no completion can recover what the
+image does not hold.
 """
 
 from __future__ import annotations
