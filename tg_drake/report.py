@@ -276,7 +276,7 @@ def _grasp_title(result: dict) -> str:
     if g["score"] is None:
         return f"grasp on {g['part']}\noutcome: {result['outcome']['status']}"
     return (f"grasp on {g['part']}: score {g['score']:.2f} = P(part|task) {g['p_part']:.2f} × "
-            f"P(grasp|shape) {g['p_local']:.2f}{_hold_text(g)}\n"
+            f"P(grasp|shape) {g['p_local']:.2f}{_hold_text(g, result)}\n"
             f"outcome: {result['outcome']['status']}")
 
 

@@ -32,3 +32,12 @@ def test_the_missing_pictures_are_named_in_the_result(tmp_path):
     write(tmp_path, result, Pictures(Stages(scene=broken)))
     written = json.loads((tmp_path / "result.json").read_text())
     assert [w.split()[0] for w in written["warnings"]] == ["parts.png"]
+
+
+def test_the_grasp_picture_title_and_the_summary_place_p_hold_as_the_stage_uses_it():
+    from tg_drake.report import _grasp_title
+    grasp = {"part": "middle", "score": 0.74, "p_part": 0.88, "p_local": 0.84, "p_hold": 0.86}
+    for ranked, shown in ((False, "; P(hold) 0.86, not ranked by"), (True, " × P(hold) 0.86")):
+        result = {"grasp": grasp, "outcome": {"status": "placed"},
+                  "config": {"pipeline": {"feasibility": {"rank_by_hold": ranked}}}}
+        assert shown in _grasp_title(result)
