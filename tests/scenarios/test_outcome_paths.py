@@ -23,9 +23,18 @@ SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 STEP = 0.25  # [s] simulated time between looks at the outcome in the hand-driven loop
 
 
+# The cases run by default (one of each outcome path: placed, the logic's refusal, unreachable, a
+# regression scenario whose run the regression tests share); every other scenario runs in
+# `make test-slow` (the multi-object scenes take 30–70 s each through both paths).
+DEFAULT_CASES = frozenset({"default.yaml", "pan_upside_down.yaml", "out_of_reach.yaml",
+                           "regression/pan_upside_down.yaml",
+                           "regression/can_sideways_place.yaml"})
+
+
 def scenario_cases() -> list:
     """(file, entry) for every top-level and regression scenario file (each named entry of a
-    multi-scenario file); suites are lists of cases, not scenarios."""
+    multi-scenario file); suites are lists of cases, not scenarios. Cases outside DEFAULT_CASES
+    are marked slow."""
     files = sorted(SCENARIOS.glob("*.yaml")) + sorted(
         p for p in (SCENARIOS / "regression").glob("*.yaml") if p.stem != "expected")
     cases = []
@@ -33,7 +42,8 @@ def scenario_cases() -> list:
         names = scenario_names(path)
         for name in names or [None]:
             label = str(path.relative_to(SCENARIOS)) + (f"#{name}" if name else "")
-            cases.append(pytest.param(path, name, id=label))
+            marks = () if label in DEFAULT_CASES else (pytest.mark.slow,)
+            cases.append(pytest.param(path, name, id=label, marks=marks))
     return cases
 
 
@@ -60,6 +70,7 @@ def test_every_scenario_file_is_a_case():
     ids = {c.id for c in scenario_cases()}
     assert "default.yaml" in ids and "regression/pan_upside_down.yaml" in ids
     assert not any("expected" in i for i in ids)
+    assert DEFAULT_CASES <= ids  # a renamed scenario does not drop out of the default run
 
 
 @pytest.mark.parametrize("path, name", scenario_cases())

@@ -21,7 +21,6 @@ from pydrake.multibody.tree import (
     RevoluteJoint,
     SpatialInertia,
 )
-from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
@@ -31,8 +30,8 @@ from tg_drake.models import make_parser
 from tg_drake.objects import WATER_DENSITY, get_object, mesh
 from tg_drake.robot import WSG_MAX_OPENING
 from tg_drake.scenario import ObjectPlacement, Scenario, default_plant_config
-from tg_drake.simulation.scripted import side_grasp_configurations
-from tg_drake.station import add_spheres, add_station
+from tg_drake.simulation.scripted import drive_station, side_grasp_configurations
+from tg_drake.station import add_spheres
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, add_table
 from tg_drake.tasks.contents import ContentsConfig, ContentsModel, container_sites, count_contents
 
@@ -105,27 +104,18 @@ def scripted_pour(scenario: Scenario, *, object_name: str, p_W_grasp, tilt: floa
     """The scripted side grasp of `object_name` at world point `p_W_grasp`, a lift of `lift`
     [m], then a turn of the wrist (iiwa joint 7) by `tilt` [rad] over 1.5 s, held 1.5 s."""
     t0 = time.perf_counter()
-    builder = DiagramBuilder()
-    station = add_station(builder, scenario=scenario)
-    plant = station.plant
     qs = side_grasp_configurations(scenario, p_W_grasp, lift=lift, pitch=pitch)
     q_tilt = qs[3].copy()
     q_tilt[6] += tilt
     # Timeline [s]: approach, move in, close, lift, tilt, hold.
     times = [0.0, 2.0, 3.0, 4.0, 5.5, 7.0, 8.5]
-    q_traj = PiecewisePolynomial.FirstOrderHold(
-        times, np.column_stack([qs[0], qs[1], qs[2], qs[2], qs[3], q_tilt, q_tilt]))
-    w_traj = PiecewisePolynomial.FirstOrderHold(
-        [0.0, 3.0, 3.8, times[-1]], np.array([[WSG_MAX_OPENING, WSG_MAX_OPENING, 0.0, 0.0]]))
-    arm_source = builder.AddSystem(TrajectorySource(q_traj, output_derivative_order=1))
-    wsg_source = builder.AddSystem(TrajectorySource(w_traj))
-    builder.Connect(arm_source.get_output_port(), station.inputs["iiwa.desired_state"])
-    builder.Connect(wsg_source.get_output_port(), station.inputs["wsg.position"])
-    diagram = builder.Build()
-    simulator = Simulator(diagram)
-    context = simulator.get_mutable_context()
-    plant_context = plant.GetMyMutableContextFromRoot(context)
-    plant.SetPositions(plant_context, station.instances["iiwa"], qs[0])
+    driven = drive_station(
+        scenario, q_times=times,
+        q_knots=np.column_stack([qs[0], qs[1], qs[2], qs[2], qs[3], q_tilt, q_tilt]),
+        w_times=[0.0, 3.0, 3.8, times[-1]],
+        w_values=[WSG_MAX_OPENING, WSG_MAX_OPENING, 0.0, 0.0])
+    station, simulator, plant_context = driven.station, driven.simulator, driven.plant_context
+    plant = station.plant
     body = station.object_body(object_name)
     z0 = body.EvalPoseInWorld(plant_context).translation()[2]
     simulator.AdvanceTo(times[-1])

@@ -76,33 +76,48 @@ def side_grasp_configurations(scenario: Scenario, p_W_grasp, *, lift: float, pit
     return qs
 
 
-def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: float = 0.10,
-                   pitch: float = np.deg2rad(30), render: bool = True,
-                   width_closed: float = 0.0) -> GraspLiftResult:
-    """Runs the scripted grasp-and-lift on `object_name`, grasping at world point `p_W_grasp`."""
+@dataclass
+class DrivenStation:
+    """A station whose arm and gripper follow fixed trajectories (`drive_station`)."""
+
+    station: object  # tg_drake.station.Station
+    simulator: Simulator
+    plant_context: object  # the plant's mutable context inside the simulator's
+
+
+def drive_station(scenario: Scenario, *, q_times, q_knots, w_times, w_values) -> DrivenStation:
+    """The scenario's station with its iiwa following the first-order hold through `q_knots`
+    ((7, K) joint positions [rad] at `q_times` [s], with their derivative as the desired velocity)
+    and its WSG the opening `w_values` [m] at `w_times` [s]; the arm starts at the first knot."""
     builder = DiagramBuilder()
     station = add_station(builder, scenario=scenario)
-    plant = station.plant
-
-    qs = side_grasp_configurations(scenario, p_W_grasp, lift=lift, pitch=pitch)
-
-    # Timeline [s]: approach, move in, close, lift, hold.
-    times = [0.0, 2.0, 3.0, 4.0, 5.5, 6.5]
-    q_knots = np.column_stack([qs[0], qs[1], qs[2], qs[2], qs[3], qs[3]])
-    q_traj = PiecewisePolynomial.FirstOrderHold(times, q_knots)
-    w_open = WSG_MAX_OPENING
-    w_traj = PiecewisePolynomial.FirstOrderHold(
-        [0.0, 3.0, 3.8, times[-1]], np.array([[w_open, w_open, width_closed, width_closed]]))
+    q_traj = PiecewisePolynomial.FirstOrderHold(list(q_times), np.asarray(q_knots, float))
+    w_traj = PiecewisePolynomial.FirstOrderHold(list(w_times), np.atleast_2d(w_values))
     arm_source = builder.AddSystem(TrajectorySource(q_traj, output_derivative_order=1))
     wsg_source = builder.AddSystem(TrajectorySource(w_traj))
     builder.Connect(arm_source.get_output_port(), station.inputs["iiwa.desired_state"])
     builder.Connect(wsg_source.get_output_port(), station.inputs["wsg.position"])
-    diagram = builder.Build()
+    simulator = Simulator(builder.Build())
+    plant_context = station.plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
+    station.plant.SetPositions(plant_context, station.instances["iiwa"],
+                               np.asarray(q_knots, float)[:, 0])
+    return DrivenStation(station, simulator, plant_context)
 
-    simulator = Simulator(diagram)
-    context = simulator.get_mutable_context()
-    plant_context = plant.GetMyMutableContextFromRoot(context)
-    plant.SetPositions(plant_context, station.instances["iiwa"], qs[0])
+
+def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: float = 0.10,
+                   pitch: float = np.deg2rad(30), render: bool = True,
+                   width_closed: float = 0.0) -> GraspLiftResult:
+    """Runs the scripted grasp-and-lift on `object_name`, grasping at world point `p_W_grasp`."""
+    qs = side_grasp_configurations(scenario, p_W_grasp, lift=lift, pitch=pitch)
+    # Timeline [s]: approach, move in, close, lift, hold.
+    times = [0.0, 2.0, 3.0, 4.0, 5.5, 6.5]
+    w_open = WSG_MAX_OPENING
+    driven = drive_station(scenario, q_times=times,
+                           q_knots=np.column_stack([qs[0], qs[1], qs[2], qs[2], qs[3], qs[3]]),
+                           w_times=[0.0, 3.0, 3.8, times[-1]],
+                           w_values=[w_open, w_open, width_closed, width_closed])
+    station, simulator, plant_context = driven.station, driven.simulator, driven.plant_context
+    plant, context = station.plant, simulator.get_mutable_context()
     body = station.object_body(object_name)
     G = plant.GetFrameByName(WSG_BODY, station.instances["wsg"])
 
