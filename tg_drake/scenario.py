@@ -162,8 +162,9 @@ class ObjectPlacement:
     xy: list[float] = field(default_factory=lambda: [0.0, 0.0])  # position in the table frame [m]
     yaw: float = 0.0  # rotation about the table normal [deg]
     containment: str = "empty"  # "empty" or "full"; full adds the contents' mass (water)
-    resting: int | str | None = None  # instead of pose: "auto" (the most probable stable pose)
-    # or K (the K-th most probable, 0 first), for objects whose library lists stable poses
+    resting: int | str | None = None  # instead of pose: "auto" (the most probable named stable
+    # pose) or K (the K-th most probable, 0 first, tilted ones included: it rests as found, and
+    # `pose` becomes the nearest label), for objects whose library lists stable poses
     mesh: str = ""  # a mesh file (OBJ STL PLY GLB DAE), a model folder (Google Scanned Objects,
     # YCB) or a one-body SDF/URDF to import: a path relative to the scenario file, or package://
     category: str = ""  # mesh entries: the true category (ground truth for evaluation only;
@@ -706,8 +707,10 @@ def _import_mesh(placement: ObjectPlacement, path: Path, labels: Path | None, wh
 
 
 def _resolve_resting(placement: ObjectPlacement, obj, where: str, f: str) -> None:
-    """`resting: auto | K` → the pose label of the object's K-th most probable stable pose (auto:
-    the most probable one that is one of its poses; a tilted pose has no label downstream)."""
+    """`resting: auto | K` → K (an int: the object rests in its K-th most probable stable pose, as
+    found) and `pose`, the label it has for perception's ground truth and the evaluation: the
+    stable pose's own name, or for a tilted pose with no name the nearest of the object's poses
+    (`nearest_pose_label`). auto is the most probable stable pose that has a name."""
     k = placement.resting
     if k == "auto":
         named = [j for j, s in enumerate(obj.stable_poses) if s.pose in obj.poses]
@@ -722,12 +725,29 @@ def _resolve_resting(placement: ObjectPlacement, obj, where: str, f: str) -> Non
         stable = obj.stable_pose(k)
     except ScenarioError as e:
         raise ScenarioError(e.message, file=where, field=f + ".resting") from None
-    if stable.pose not in obj.poses:
-        usable = [str(j) for j, s in enumerate(obj.stable_poses) if s.pose in obj.poses]
-        raise ScenarioError(f"{obj.id}'s stable pose {k} is none of its poses "
-                            f"({', '.join(obj.poses)}); allowed: auto, {', '.join(usable)}",
-                            file=where, field=f + ".resting")
-    placement.pose = stable.pose
+    placement.resting = k
+    placement.pose = (stable.pose if stable.pose in obj.poses
+                      else nearest_pose_label(stable.X_TO, obj))
+
+
+def nearest_pose_label(X_TO: np.ndarray, obj) -> str:
+    """The object's pose label (among `obj.poses`) whose direction of O's z axis in the table
+    frame is nearest to X_TO's: z up is upright, down upsidedown, horizontal sideways; a tool's
+    only rest, flat, has z up (it is called sideways)."""
+    up = float(np.clip(np.asarray(X_TO)[2, 2], -1.0, 1.0))  # z_O · z_T
+    tilt = ({"sideways": math.acos(up)} if obj.is_tool else
+            {"upright": math.acos(up), "upsidedown": math.acos(-up),
+             "sideways": math.asin(abs(up))})
+    names = [name for name in obj.poses if name in tilt] or list(tilt)  # none named: any
+    return min(names, key=tilt.__getitem__)
+
+
+def placement_X_TO(placement: ObjectPlacement, obj) -> np.ndarray:
+    """4×4 X_TO of a placed object before its xy and yaw: its stable pose K when `resting` was
+    resolved to K, else the library's resting transform for its `pose`."""
+    if isinstance(placement.resting, int) and not isinstance(placement.resting, bool):
+        return np.asarray(obj.stable_pose(placement.resting).X_TO)
+    return np.asarray(obj.resting_pose(placement.pose).X_TO)
 
 
 # Drake's names (MultibodyPlantConfig): contact models, discrete approximations, surfaces.
@@ -812,7 +832,7 @@ def _footprint_points(scenario: Scenario, placement: ObjectPlacement) -> np.ndar
     """(V, 3) the object's mesh vertices in the table frame T, as placed [m]."""
 
     obj = get_object(placement.id)
-    X_TO = np.asarray(obj.resting_pose(placement.pose).X_TO)
+    X_TO = placement_X_TO(placement, obj)
     yaw = np.deg2rad(placement.yaw)
     X_T = np.eye(4)
     X_T[:2, :2] = [[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]]

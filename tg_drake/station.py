@@ -91,6 +91,7 @@ from tg_drake.scenario import (
     ObjectPlacement,
     Scenario,
     WsgPdDriver,
+    placement_X_TO,
     resolve_objects,
 )
 from tg_drake.table import add_surfaces, add_table
@@ -110,9 +111,8 @@ NO_LCM = "memq://null"  # the LCM URL that publishes nothing: the station sends 
 
 def placement_pose(scenario: Scenario, placement: ObjectPlacement) -> RigidTransform:
     """X_WO of a placed object: table frame · (xy, yaw on the table) · the library's resting
-    X_TO."""
-    obj = get_object(placement.id)
-    X_TO = obj.resting_pose(placement.pose).X_TO
+    X_TO (or its stable pose K: `resting: K`)."""
+    X_TO = placement_X_TO(placement, get_object(placement.id))
     X_T_yaw = RigidTransform(RollPitchYaw(0, 0, np.deg2rad(placement.yaw)),
                              [placement.xy[0], placement.xy[1], 0.0])
     X_WT = scenario.X_WT.GetDeterministicValue()

@@ -4,12 +4,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from library_helpers import copy_object
+from pydrake.math import RigidTransform, RollPitchYaw
 
 from tg_drake.errors import ModelError, ScenarioError
 from tg_drake.objects import forget_registered, get_object, load_library
-from tg_drake.scenario import load_scenario
+from tg_drake.scenario import load_scenario, nearest_pose_label
+from tg_drake.station import placement_pose
 
 
 @pytest.fixture(autouse=True)
@@ -103,7 +106,8 @@ def test_resting_k_picks_the_kth_most_probable_stable_pose(tmp_path):
                                 f"objects: [{{id: my_mug, resting: {resting}}}]\n")
         placement = load_scenario(path).objects[0]
         assert placement.pose == pose
-    # A tilted stable pose (no name) first: auto takes the most probable named one, K = 0 fails.
+    # A tilted stable pose (no name) first: auto takes the most probable named one; K = 0 rests
+    # as found, labelled with the nearest of its poses (28.6° from upright).
     stable = [dict(pose=None, probability=0.6, xyz=[0, 0, 0.03], rpy=[0.5, 0, 0],
                    support_margin=0.001)] + [
         dict(pose=p, probability=0.1, support_margin=0.01, **{k: list(v) for k, v in (
@@ -112,10 +116,18 @@ def test_resting_k_picks_the_kth_most_probable_stable_pose(tmp_path):
     path = _write(tmp_path, "object_libraries: [lib]\nobjects: [{id: tilted_mug, resting: auto}]\n")
     assert load_scenario(path).objects[0].pose == names[0]
     path = _write(tmp_path, "object_libraries: [lib]\nobjects: [{id: tilted_mug, resting: 0}]\n")
-    with pytest.raises(ScenarioError, match=r"tilted_mug's stable pose 0 is none of its poses "
-                                            r"\(upright, sideways, upsidedown\); allowed: auto, 1, "
-                                            r"2, 3"):
-        load_scenario(path)
+    scenario = load_scenario(path)
+    placement = scenario.objects[0]
+    assert (placement.pose, placement.resting) == ("upright", 0)
+    X_WO = placement_pose(scenario, placement)
+    assert X_WO.rotation().ToRollPitchYaw().roll_angle() == pytest.approx(0.5, abs=1e-9)
+    assert X_WO.translation()[2] - scenario.X_WT.GetDeterministicValue().translation()[2] \
+        == pytest.approx(0.03)
+    # The label is the nearest pose the object has: tilted 80°, a cup is sideways.
+    obj = load_library(tmp_path / "lib")["tilted_mug"]
+    tilted = RigidTransform(RollPitchYaw(np.deg2rad(80), 0, 0), [0, 0, 0]).GetAsMatrix4()
+    assert nearest_pose_label(tilted, obj) == "sideways"
+    assert nearest_pose_label(np.diag([1.0, -1, -1, 1]), obj) == "upsidedown"
     path = _write(tmp_path, "object_libraries: [lib]\nobjects: [{id: my_mug, resting: 9}]\n")
     with pytest.raises(ScenarioError, match=r"my_mug has no stable pose 9; allowed: 0 \(upright, "
                                             r"p=0.50\), 1 \(") as e:
