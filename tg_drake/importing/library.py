@@ -43,7 +43,7 @@ from tg_drake.importing.source import resolve, sanitise_id
 from tg_drake.types import CATEGORIES, PART_LABELS, POSES
 
 MATERIAL = "unknown"  # an imported object's material (its density is what matters)
-FORMAT_VERSION = 1  # of the cache: a change of what an import writes bumps it
+FORMAT_VERSION = 2  # of the cache: a change of what an import writes bumps it
 HEADER = ("# An object library written by `tg-drake import-object` (tg_drake.importing), in the\n"
           "# format of the shipped models/objects/library.yaml (see its header for the fields\n"
           "# and units); source, labels and stable_poses say where each entry came from.\n")
@@ -153,7 +153,14 @@ def import_object(source: str | Path, options: ImportOptions, out_dir: Path, *,
         frame_kind=frame.kind, frame_notes=tuple(frame.notes), mass=mp, poses=tuple(poses),
         pieces=tuple(pieces), backend=options.collision, seconds=seconds)
     entry = _entry(d, frame, options, src)
-    write_object(out_dir, obj_id, entry, V_O, normals_O, F, labels, pieces, mp)
+    # The file's texture, when it has one, on its own vertices carried into O by the same
+    # scale, turn and shift (a similarity: the repair only merges and drops): illustration only.
+    A_OF = X_OM[:3, :3] @ UP_AXES[placement.up_axis] * (np.asarray(src.scale, float)
+                                                        * placement.factor)
+    textured = (None if loaded.textured is None else
+                _textured_in_O(loaded.textured, A_OF, X_OM[:3, 3]))
+    write_object(out_dir, obj_id, entry, V_O, normals_O, F, labels, pieces, mp,
+                 textured=textured)
     lap("write")
     pics = report.pictures(d, out_dir / "pictures") if pictures else ()
     if pictures:
@@ -255,8 +262,46 @@ def obj_text(obj_id: str, V: np.ndarray, normals: np.ndarray, F: np.ndarray) -> 
     return head + f"o {obj_id}\n" + v + "\n" + vn + "\n" + f + "\n"
 
 
-def sdf_text(obj_id: str, entry: dict, mp, piece_uris: list[str]) -> str:
+def _textured_in_O(mesh: trimesh.Trimesh, A: np.ndarray, t: np.ndarray) -> trimesh.Trimesh:
+    """A copy of the textured file mesh with its vertices A·v + t (object frame O, metres), its
+    material white (the texture's colours as they are: a tint would darken them)."""
+    m = mesh.copy()
+    m.vertices = np.asarray(mesh.vertices, float) @ np.asarray(A).T + np.asarray(t)
+    material = m.visual.material
+    if isinstance(material, trimesh.visual.material.PBRMaterial):
+        material = material.to_simple()
+    material.diffuse = [255, 255, 255, 255]
+    material.ambient = [255, 255, 255, 255]
+    m.visual.material = material
+    return m
+
+
+def textured_visual_files(obj_id: str, mesh: trimesh.Trimesh) -> dict[str, bytes]:
+    """file name → bytes of the textured visual: `<id>_textured.obj`, its .mtl and image."""
+    text, files = trimesh.exchange.obj.export_obj(
+        mesh, include_normals=False, return_texture=True, mtl_name=f"{obj_id}_textured.mtl",
+        header=f"{obj_id}: the imported file's textured mesh (metres, object frame O)")
+    return {f"{obj_id}_textured.obj": text.encode(), **files}
+
+
+def _textured_visual_sdf(uri: str) -> str:
+    return f"""      <visual name="visual_textured">
+        <geometry>
+          <mesh><uri>{uri}</uri></mesh>
+        </geometry>
+        <drake:perception_properties enabled="false"/>
+      </visual>
+"""
+
+
+def sdf_text(obj_id: str, entry: dict, mp, piece_uris: list[str], *,
+             textured_uri: str | None = None) -> str:
+    """The object's SDF: inertia, the repaired mesh as the visual that cameras see (grey; hidden
+    from the illustration when the file's texture is kept as a second visual), the pieces."""
     J, c = mp.inertia, mp.com
+    hide = ('\n        <drake:illustration_properties enabled="false"/>' if textured_uri
+            else "")
+    textured = _textured_visual_sdf(textured_uri) if textured_uri else ""
     return f"""<?xml version="1.0"?>
 <!-- Written by tg-drake import-object from {Path(entry['source']['file']).name}:
      mass {mp.mass:.4f} kg ({mp.solid}); collision: {len(piece_uris)} convex pieces. -->
@@ -281,9 +326,9 @@ def sdf_text(obj_id: str, entry: dict, mp, piece_uris: list[str]) -> str:
         </geometry>
         <material>
           <diffuse>0.700 0.700 0.700 1</diffuse>
-        </material>
+        </material>{hide}
       </visual>
-{collision.collision_sdf(piece_uris)}
+{textured}{collision.collision_sdf(piece_uris)}
     </link>
   </model>
 </sdf>
@@ -291,8 +336,9 @@ def sdf_text(obj_id: str, entry: dict, mp, piece_uris: list[str]) -> str:
 
 
 def write_object(out_dir: Path, obj_id: str, entry: dict, V, normals, F, labels, pieces,
-                 mp) -> None:
-    """Writes DIR/<id>/ and merges the entry into DIR/library.yaml."""
+                 mp, *, textured: trimesh.Trimesh | None = None) -> None:
+    """Writes DIR/<id>/ (with the textured visual's files when `textured` is given) and merges
+    the entry into DIR/library.yaml."""
     d = out_dir / obj_id
     if d.exists():
         shutil.rmtree(d)  # a re-import replaces the object's files (stale pieces go)
@@ -305,7 +351,13 @@ def write_object(out_dir: Path, obj_id: str, entry: dict, V, normals, F, labels,
         uri = f"{obj_id}_collision_{k}.obj"
         (d / uri).write_text(collision.piece_obj_text(p, f"{obj_id}_collision_{k}"))
         uris.append(uri)
-    (d / f"{obj_id}.sdf").write_text(sdf_text(obj_id, entry, mp, uris))
+    textured_uri = None
+    if textured is not None:
+        for name, data in textured_visual_files(obj_id, textured).items():
+            (d / name).write_bytes(data)
+        textured_uri = f"{obj_id}_textured.obj"
+    (d / f"{obj_id}.sdf").write_text(sdf_text(obj_id, entry, mp, uris,
+                                              textured_uri=textured_uri))
     merge_entry(out_dir / "library.yaml", obj_id, entry)
 
 

@@ -49,6 +49,8 @@ class LoadedMesh:
     vertices: np.ndarray  # (V, 3) in file units, file axes
     faces: np.ndarray  # (F, 3) int64
     n_geometries: int  # meshes of the file (a scene's are concatenated)
+    textured: object = None  # the file's one mesh as trimesh loaded it, when it carries a texture
+    # image and its coordinates (a scan's colours: kept for the illustration), else None
 
 
 @dataclass(frozen=True)
@@ -108,7 +110,23 @@ def load(path, *, file_for_errors: str | None = None) -> LoadedMesh:
     V, F = np.concatenate(V), np.concatenate(F)
     if not np.isfinite(V).all():
         raise ModelError("the mesh has non-finite vertex coordinates", file=name)
-    return LoadedMesh(V, F, len(geoms))
+    return LoadedMesh(V, F, len(geoms), textured=_textured(geoms))
+
+
+def _textured(geoms: list) -> trimesh.Trimesh | None:
+    """The one mesh when it has texture coordinates and an image (PBR materials simplified to a
+    diffuse map), else None: a scene of several meshes keeps no texture."""
+    if len(geoms) != 1 or not isinstance(geoms[0].visual, trimesh.visual.TextureVisuals):
+        return None
+    visual = geoms[0].visual
+    if visual.uv is None or len(visual.uv) != len(geoms[0].vertices):
+        return None
+    material = visual.material
+    if isinstance(material, trimesh.visual.material.PBRMaterial):
+        material = material.to_simple()
+    if getattr(material, "image", None) is None:
+        return None
+    return geoms[0]
 
 
 def infer_units(size: float) -> tuple[str, str]:
