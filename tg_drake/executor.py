@@ -339,6 +339,37 @@ def die_with_parent(parent_pid: int) -> None:
     threading.Thread(target=watch, name="die-with-parent", daemon=True).start()
 
 
+RAY_TEMP_PREFIX = "tg-ray-"  # a local Ray instance's own temp folder: <tmp>/tg-ray-XXXXXXXX
+RAY_DRIVER_FILE = "driver.pid"  # in it: the pid of the process that started the instance
+
+
+def remove_stale_ray_folders(root: str | Path) -> list[Path]:
+    """Removes the local Ray temp folders under `root` whose driver is gone (killed before its
+    shutdown removed them: Ray's own processes exit within about two minutes of the driver, the
+    folder stays); the removed folders. A folder without a driver file, or whose driver is
+    alive, is kept."""
+    removed = []
+    for d in Path(root).glob(RAY_TEMP_PREFIX + "*"):
+        try:
+            pid = int((d / RAY_DRIVER_FILE).read_text().strip())
+        except (OSError, ValueError):
+            continue
+        if not _alive(pid):
+            shutil.rmtree(d, ignore_errors=True)
+            removed.append(d)
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process
+        return True
+    return True
+
+
 class RayExecutor(Executor):
     """Jobs as Ray tasks on a cluster (`address`: host:port, ray://host:port or "auto") or on a
     local Ray instance started for the sweep (None or "local"; None means RAY_ADDRESS if it is
@@ -384,7 +415,10 @@ class RayExecutor(Executor):
         # neither joined nor reused. The folder is short: Ray's sockets live under it, and a Unix
         # socket's path has at most 107 bytes.
         base = tempfile.gettempdir()
-        temp_dir = tempfile.mkdtemp(prefix="tg-ray-", dir=base if len(base) <= 20 else "/tmp")
+        root = base if len(base) <= 20 else "/tmp"
+        remove_stale_ray_folders(root)
+        temp_dir = tempfile.mkdtemp(prefix=RAY_TEMP_PREFIX, dir=root)
+        Path(temp_dir, RAY_DRIVER_FILE).write_text(f"{os.getpid()}\n")
         ray.init(address="local", _temp_dir=temp_dir)
         return temp_dir
 

@@ -16,12 +16,14 @@ import pytest
 from tg_drake.errors import OutputError, TgDrakeError
 from tg_drake.executor import (
     RAY_ATTEMPTS,
+    RAY_DRIVER_FILE,
     WORKER_DIED,
     Job,
     LocalExecutor,
     finished_jobs,
     make_executor,
     read_records,
+    remove_stale_ray_folders,
     run_jobs,
 )
 
@@ -449,3 +451,21 @@ def test_pool_workers_get_their_share_of_the_cores_for_thread_pools(tmp_path, mo
     (record,) = read(out)
     assert record["OMP_NUM_THREADS"] == str(max(1, (os.cpu_count() or 1) // 2))
     assert record["OPENBLAS_NUM_THREADS"] == "3"
+
+
+def test_a_killed_drivers_ray_folder_is_removed_by_the_next_start(tmp_path):
+    """A driver killed with kill -9 leaves its local Ray temp folder (Ray's processes exit on
+    their own); the next local start removes the folders whose driver is gone, and only those."""
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    folders = {}
+    for name, pid in (("dead", dead.pid), ("alive", os.getpid()), ("unmarked", None)):
+        d = tmp_path / f"tg-ray-{name}"
+        (d / "session_latest").mkdir(parents=True)
+        if pid is not None:
+            (d / RAY_DRIVER_FILE).write_text(f"{pid}\n")
+        folders[name] = d
+    (tmp_path / "other-dead").mkdir()  # not ours: never looked at
+    assert remove_stale_ray_folders(tmp_path) == [folders["dead"]]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "other-dead", "tg-ray-alive", "tg-ray-unmarked"]
