@@ -13,6 +13,7 @@ import importlib
 import os
 import sys
 
+from tg_drake import __version__
 from tg_drake.errors import TgDrakeError
 from tg_drake.outputs import check_output_dir, check_output_file
 
@@ -28,6 +29,19 @@ COMMANDS: dict[str, str] = {
     "cache": "tg_drake.importing.cache",
 }
 
+# command → an example for its --help (each runs from the repository's root).
+EXAMPLES: dict[str, str] = {
+    "query": "tg-drake query rules/examples/fig1_cup.yaml --json",
+    "bench": "tg-drake bench --only sim_rtf --out bench.json",
+    "objects": "tg-drake objects --json",
+    "render": "tg-drake render scenarios/default.yaml --out out/render",
+    "run": "tg-drake run scenarios/default.yaml --out out/default --meshcat",
+    "eval": "tg-drake eval scenarios/suites/tiny.yaml --out out/tiny --workers 2",
+    "import-object": ("tg-drake import-object mugs/blue_mug.obj --category cup --units auto "
+                      "--up-axis z --mass 0.35 --out my_objects"),
+    "cache": "tg-drake cache --prune-days 30",
+}
+
 # command → its options that name a path it writes, and whether each is a "folder" or a "file".
 # Checked before the command starts, so a bad path is answered before any work.
 OUTPUTS: dict[str, dict[str, str]] = {
@@ -41,11 +55,16 @@ OUTPUTS: dict[str, dict[str, str]] = {
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="tg-drake", description="Task-dependent robot grasping in Drake.")
+        prog="tg-drake", description="Task-dependent robot grasping in Drake.",
+        epilog="exit status: 0 done (see `tg-drake run --help`), 1 the run or task failed, 2 bad "
+        "input or usage", formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"tg-drake {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, module_name in COMMANDS.items():
         module = importlib.import_module(module_name)
-        p = sub.add_parser(name, help=module.HELP, description=module.HELP)
+        p = sub.add_parser(name, help=module.HELP, description=module.HELP,
+                           epilog=f"example:\n  {EXAMPLES[name]}",
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
         module.add_arguments(p)
         p.set_defaults(_module=module)
     return parser

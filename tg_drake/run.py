@@ -40,7 +40,13 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", type=Path, default=None,
                         help="output folder (default: out/<scenario name>)")
     parser.add_argument("--meshcat", action="store_true",
-                        help="serve Drake's Meshcat viewer on localhost and replay the run there")
+                        help="serve Drake's Meshcat viewer and replay the run there (on "
+                        "--meshcat-host, localhost unless given)")
+    parser.add_argument("--meshcat-host", default="localhost", metavar="HOST",
+                        help="the interface Meshcat listens on (default: localhost, this machine "
+                        "only; 0.0.0.0 or * for every interface, to view it from elsewhere)")
+    parser.add_argument("--meshcat-port", type=int, default=None, metavar="PORT",
+                        help="Meshcat's port (default: the first free one from 7000)")
     parser.add_argument("--no-images", action="store_true", help="skip the PNG pictures")
     parser.add_argument("--theory", choices=THEORY_VARIANTS, default=None,
                         help="both models of this theory variant, overriding the scenario's "
@@ -145,6 +151,25 @@ def run_scenario(scenario, *, scenario_path: str = "", meshcat=None) -> dict:
     return run(scenario, scenario_path=scenario_path, meshcat=meshcat)[0]
 
 
+def start_meshcat(host: str = "localhost", port: int | None = None):
+    """Drake's Meshcat listening on `host` (localhost: this machine only; Drake's own default
+    serves every interface) and `port` (None: the first free one from 7000); TgDrakeError naming
+    the option when the port is out of range or cannot be opened."""
+    from pydrake.geometry import Meshcat, MeshcatParams
+
+    if port is not None and not 1 <= port <= 65535:
+        raise TgDrakeError(f"--meshcat-port must be a port number 1..65535, got {port}")
+    params = MeshcatParams()
+    params.host = host
+    if port is not None:
+        params.port = port
+    try:
+        return Meshcat(params)
+    except RuntimeError as e:
+        raise TgDrakeError(f"Meshcat cannot listen on --meshcat-host {host!r} --meshcat-port "
+                           f"{port if port is not None else 'auto'}: {e}") from None
+
+
 def main(args) -> int:
     from tg_drake.report import summary, write
     from tg_drake.scenario import load_scenario
@@ -155,8 +180,7 @@ def main(args) -> int:
     out = args.out or default_out(args)
     meshcat = None
     if args.meshcat:
-        from pydrake.geometry import StartMeshcat
-        meshcat = StartMeshcat()
+        meshcat = start_meshcat(args.meshcat_host, args.meshcat_port)
         print(f"Meshcat: {meshcat.web_url()}")
     result, pictures = run(scenario, scenario_path=str(args.scenario), meshcat=meshcat,
                            images=not args.no_images)
