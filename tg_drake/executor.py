@@ -635,8 +635,11 @@ def finished_jobs(out: Path, *, retry_errors: bool = False) -> set[str]:
 
 def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, executor: Executor,
              retry_errors: bool = False, progress: bool = True,
-             outcome_of: Callable[[list[dict]], str] | None = None) -> RunSummary:
+             outcome_of: Callable[[list[dict]], str] | None = None,
+             label: str | None = None) -> RunSummary:
     """Runs the jobs not yet in `out` and appends their records to it as they finish.
+
+    `label` names the work on the progress bar (default: the results file's name).
 
     `fn` must be importable by name (a module-level function) for process and Ray executors.
     `outcome_of(records)` names a finished job's outcome for the progress bar's counts (default
@@ -660,7 +663,7 @@ def run_jobs(fn: Callable[[Any], Any], jobs: Iterable[Job], *, out: Path, execut
         from tqdm import tqdm  # start-up: this module is on `tg-drake --help`'s path; tqdm ~0.5 s
 
         # smoothing 0: the ETA from the mean time per job so far (jobs differ tenfold in cost).
-        bar = tqdm(total=len(todo), desc=out.name, unit="job", bar_format=BAR_FORMAT,
+        bar = tqdm(total=len(todo), desc=label or out.name, unit="job", bar_format=BAR_FORMAT,
                    smoothing=0.0)
     counts: dict[str, int] = {}
     shown: set[str] = set()  # log lines already printed above the bar

@@ -81,3 +81,10 @@ def test_every_command_is_in_the_readme_and_its_help_has_an_example_and_the_read
         assert example[:2] == ["tg-drake", command], command
         for option in options:
             assert option in text, (command, option)
+
+
+def test_the_eval_progress_bar_names_the_suites():
+    from tg_drake.evaluation.cli import progress_label
+    assert progress_label(["scenarios/suites/s_grasp.yaml", "x/tiny.yaml"]) == "s_grasp, tiny"
+    assert progress_label(["a.yaml"], (2, 4)) == "a [2/4]"
+    assert progress_label([f"suite_number_{k}.yaml" for k in range(5)]) == "5 suites"

@@ -157,6 +157,14 @@ def write_tables(out_dir: Path, records: list[dict], command: str, notes: str = 
     return tables
 
 
+def progress_label(suites, sharded=None) -> str:
+    """The progress bar's name for the work: the suites' file stems (and the shard)."""
+    names = ", ".join(Path(s).stem for s in suites)
+    if len(names) > 40:
+        names = f"{len(suites)} suites"
+    return f"{names} [{sharded[0]}/{sharded[1]}]" if sharded else names
+
+
 def main(args) -> int:
     if not re.fullmatch(r"[\w.-]+", args.name):
         raise ScenarioError(f"--name is a file stem (letters, digits, '_', '-', '.'), got "
@@ -180,7 +188,8 @@ def main(args) -> int:
         todo = shard(cases, *sharded) if sharded else cases
         executor = make_executor(args.executor, workers=args.workers, address=args.address)
         summary = run_jobs(_run, [Job(c.key, c) for c in todo], out=out, executor=executor,
-                           retry_errors=args.retry_errors, outcome_of=outcome_label)
+                           retry_errors=args.retry_errors, outcome_of=outcome_label,
+                           label=progress_label(args.suites, sharded))
         where = f"shard {sharded[0]}/{sharded[1]}: " if sharded else ""
         print(f"{where}{summary.n_jobs} cases: {summary.n_skipped} already done, {summary.n_ran} "
               f"run now ({summary.n_errors} recorded as errors)", file=sys.stderr)
