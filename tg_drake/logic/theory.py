@@ -33,6 +33,7 @@ from problog.logic import And, AnnotatedDisjunction, Clause, Constant, Not, Term
 from problog.program import PrologFile
 
 from tg_drake.errors import RuleError, unknown_name
+from tg_drake.logic.check import check_constants
 from tg_drake.types import THEORY_VARIANTS as VARIANTS
 
 # Files of every variant, in load order; {category} and {grasp} are the variant names.
@@ -123,10 +124,12 @@ def theory_paths(config: TheoryConfig, directory: Path | None = None) -> list[Pa
 
 
 def load_theory(config: TheoryConfig, directory: Path | None = None) -> list[SourceClause]:
-    """Parses the variant's files; a missing or malformed file raises RuleError naming it."""
+    """Parses the variant's files; a missing or malformed file, or a body literal with a
+    constant nothing ever gives (a typo: tg_drake.logic.check), raises RuleError naming it."""
     clauses = []
     for path in theory_paths(config, directory):
         clauses.extend(_load_file(path))
+    check_constants(clauses)
     return clauses
 
 
