@@ -62,3 +62,16 @@ def test_unknown_selection_or_part_is_refused():
         rank_grasps(scene(), SEMANTICS, FixedModel(), selection="best")
     with pytest.raises(GraspingError, match="unknown part 'lid'"):
         rank_grasps(scene(), SEMANTICS, FixedModel(), selection="one_part", part="lid")
+
+
+def test_an_executed_pose_is_matched_to_the_scored_pose_it_is():
+    from tg_drake.grasping.expansion import tilted
+    from tg_drake.grasping.scoring import scored_pose_match
+
+    ranked = rank_grasps(scene(), SEMANTICS, FixedModel())
+    same = scored_pose_match(ranked.X_WG[2].copy(), ranked)
+    assert same["same"] and same["offset_m"] == 0.0 and same["p_local"] == ranked.p_local[0]
+    # The same hypothesis tilted by 10° about its grasp point (what the feasibility stage used to
+    # execute): not a pose the DGI scored.
+    other = scored_pose_match(tilted(ranked.X_WG[0], np.deg2rad(10.0)), ranked)
+    assert not other["same"] and np.degrees(other["angle_rad"]) == pytest.approx(10.0)
