@@ -16,9 +16,10 @@ Wiring (docs/design.md, "The diagram"):
         (latched: perceived at initialization and on a new perception_request, never live)
     scene_description ─▶ prior ─▶ category_prior
     scene_description, category_prior, task, collisions ─▶ logic ─▶ grasp_semantics
-    scene_description, grasp_semantics ─▶ scoring ─▶ ranked_grasps (ports: scored_grasps)
-    scene_description, grasp_semantics, ranked_grasps ─▶ feasibility ─▶ ranked_grasps (the
-        poses that will be executed, with P(hold))
+    scene_description, grasp_semantics ─▶ scoring ─▶ ranked_grasps (ports: scored_grasps; the
+        hypotheses turned into the poses that may be executed, each scored by the DGI)
+    scene_description, grasp_semantics, ranked_grasps ─▶ feasibility ─▶ ranked_grasps (those
+        poses as they are, with collisions and P(hold))
     scene_description, ranked_grasps, iiwa.state, plan_request ─▶ planner ─▶ iiwa.desired_state,
         wsg.position, plan_status
     scene_description, grasp_semantics, ranked_grasps, plan_status, wsg.state, body_poses,
@@ -177,7 +178,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     builder.Connect(task.get_output_port(), logic.GetInputPort("task"))
     scoring = builder.AddNamedSystem("dgi_scoring", DgiScoringSystem(
         load_model(config.scoring.model) if config.scoring.model else None,
-        selection=config.selection, part=getattr(config.scoring, "part", None)))
+        selection=config.selection, part=getattr(config.scoring, "part", None),
+        expansion=config.expansion, approach=config.planner.pregrasp_distance))
     builder.Connect(scene, scoring.GetInputPort("scene_description"))
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     scoring.GetInputPort("grasp_semantics"))
@@ -186,7 +188,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     supervision = config.supervisor
     X_WT = scenario.X_WT.GetDeterministicValue()
     place_xy_W = (X_WT @ np.array([*scenario.task.place_xy, 0.0, 1.0]))[:2]
-    # Feasibility: the poses that will be executed, with P(hold); the planner plans them.
+    # Feasibility: the scored poses, with collisions and P(hold); the planner plans them.
     feasibility = builder.AddNamedSystem("feasibility", GraspFeasibility(
         config.feasibility, approach=config.planner.pregrasp_distance))
     builder.Connect(scene, feasibility.GetInputPort("scene_description"))

@@ -19,6 +19,7 @@ from pydrake.math import RigidTransform, RollPitchYaw
 
 from tg_drake import robot
 from tg_drake.errors import TgDrakeError
+from tg_drake.grasping.scoring import scored_pose_match
 from tg_drake.perception.plot import save_scene_png
 from tg_drake.types import PART_COLORS
 
@@ -32,6 +33,7 @@ class Stages:
     prior: object = None  # CategoryDistribution
     semantics: object = None  # GraspSemantics
     ranked: object = None  # GraspCandidates
+    scored: object = None  # GraspCandidates: the scoring stage's (the poses the DGI scored)
     rgb: np.ndarray | None = None  # (H, W, 3) camera image, when pictures are wanted
     warnings: list = field(default_factory=list)
 
@@ -69,10 +71,11 @@ def evaluate_stages(pipeline, context, timings: dict, *, rgb: bool = False) -> S
         stages.prior = timed("kernel_prior", pipeline.ports["category_prior"])
         stages.semantics = timed("logic", pipeline.ports["grasp_semantics"])
         if "scored_grasps" in pipeline.ports:
-            timed("dgi_scoring", pipeline.ports["scored_grasps"])
+            stages.scored = timed("dgi_scoring", pipeline.ports["scored_grasps"])
             stages.ranked = timed("feasibility", pipeline.ports["ranked_grasps"])
         else:
             stages.ranked = timed("dgi_scoring", pipeline.ports["ranked_grasps"])
+            stages.scored = stages.ranked
     except TgDrakeError:
         pass
     return stages
@@ -85,12 +88,15 @@ def final_stages(pipeline, context, stages: Stages, outcome) -> Stages:
         return stages
     final = Stages(scene=stages.scene, prior=stages.prior, rgb=stages.rgb,
                    warnings=list(stages.warnings))
+    ports = {"semantics": "grasp_semantics", "ranked": "ranked_grasps",
+             "scored": "scored_grasps" if "scored_grasps" in pipeline.ports else "ranked_grasps"}
     try:
-        for name in ("semantics", "ranked"):
-            port = pipeline.ports["grasp_semantics" if name == "semantics" else "ranked_grasps"]
+        for name, port_name in ports.items():
+            port = pipeline.ports[port_name]
             setattr(final, name, port.Eval(port.get_system().GetMyContextFromRoot(context)))
     except TgDrakeError as e:
         final.semantics, final.ranked = stages.semantics, stages.ranked
+        final.scored = stages.scored
         final.warnings.append(f"the stages after the re-queries could not be evaluated ({e}); "
                               "category, task, part and grasp scores are those of the start")
     return final
@@ -128,6 +134,9 @@ def result_of(*, scenario, scenario_path: str, stages: Stages, outcome, plan_sta
                                "p_hold": (float(ranked.p_hold[i]) if known
                                           and ranked.p_hold is not None else None),
                                "score": float(ranked.score[i]) if known else None}
+            if stages.scored is not None:
+                result["grasp"]["scored_pose"] = _scored_pose_json(plan_status.X_WG,
+                                                                   stages.scored)
     result["outcome"] = outcome.as_dict()
     if outcome.task_outcome is not None:
         result["task_outcome"] = outcome.task_outcome.as_dict()
@@ -136,6 +145,16 @@ def result_of(*, scenario, scenario_path: str, stages: Stages, outcome, plan_sta
     result["timings"] = {k: round(v, 4) for k, v in timings.items()}
     result["config"] = yaml_load(data=yaml_dump_typed(scenario))  # the full resolved scenario
     return result
+
+
+def _scored_pose_json(X_WG, scored) -> dict:
+    """Is the executed grasp pose one the DGI scored? (`scoring.scored_pose_match`, in mm and
+    degrees; `same` is the check.)"""
+    m = scored_pose_match(np.asarray(X_WG, float), scored)
+    return {"same": m["same"], "index": m["index"],
+            "offset_mm": None if m["offset_m"] is None else round(m["offset_m"] * 1000, 4),
+            "angle_deg": None if m["angle_rad"] is None else round(np.degrees(m["angle_rad"]), 4),
+            "p_local": m["p_local"]}
 
 
 @dataclass

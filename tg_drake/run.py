@@ -8,7 +8,8 @@ passed (outcome failed, "timeout") → write `result.json`, then the pictures (`
 result.json holds: `scenario`, `task_given`, `perception` (`pose`, `parts`, ...), `category_prior`,
 `category`, `task`, `part` (each a distribution: name → probability), `collisions` (the parts given
 to the logic as collision evidence), `explanations`, `grasp_probability`, `n_hypotheses`,
-`planning`, `grasp` (`xyz`, `rpy`, `part`, `p_part`, `p_local`, `score`), `outcome` (`status`: one
+`planning`, `grasp` (`xyz`, `rpy`, `part`, `p_part`, `p_local`, `score`, `scored_pose`: is the
+executed pose one the DGI scored — `same`, `offset_mm`, `angle_deg`), `outcome` (`status`: one
 of `OUTCOME_STATUSES`; `reason`: one of `FAILURE_REASONS` or ""; `detail`; the closed loop's
 parts and re-queries), `timings` (seconds) and `config` (the full resolved scenario).
 

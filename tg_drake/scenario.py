@@ -34,6 +34,7 @@ from pydrake.systems.sensors import CameraConfig
 from scipy.spatial import ConvexHull
 
 from tg_drake.errors import ModelError, RuleError, ScenarioError, unknown_name
+from tg_drake.grasping.expansion import ExpansionConfig
 from tg_drake.grasping.feasibility import FeasibilityConfig
 from tg_drake.kernels.database import SOURCES as KERNEL_SOURCES
 from tg_drake.kernels.database import KernelPriorConfig
@@ -312,6 +313,8 @@ class PipelineConfig:
     scoring: ScoringVariant = field(default_factory=DgiScorer)  # how hypotheses are ranked
     feasibility: FeasibilityConfig = field(default_factory=FeasibilityConfig)  # collision and
     # P(hold) of the poses that will be executed (tg_drake.grasping.feasibility)
+    expansion: ExpansionConfig = field(default_factory=ExpansionConfig)  # hypothesis → the
+    # poses that may be executed, scored by the DGI (tg_drake.grasping.expansion)
     planner: PlannerConfig = field(default_factory=PlannerConfig)  # the pick-and-place plan
     supervisor: SupervisorConfig = field(default_factory=SupervisorConfig)  # the closed loop:
     # gate, re-queries, waiting for plans, execution monitor
@@ -346,6 +349,7 @@ class PipelineConfig:
         if self.scoring.model and not Path(self.scoring.model).is_file():
             raise ScenarioError(f"no such DGI model file {self.scoring.model!r}",
                                 field=f"{where}.scoring.model")
+        self.expansion.validate(f"{where}.expansion")
         self.feasibility.validate(f"{where}.feasibility")
         self.supervisor.validate(f"{where}.supervisor")
         self.tasks.validate(f"{where}.tasks")

@@ -112,12 +112,16 @@ def collect(argv=None) -> int:
     parser.add_argument("--object-mass", type=float, default=0.0,
                         help="> 0: every object weighs this much [kg] (its inertia scaled, its "
                              "shape and centre of mass kept): labels of local shape alone")
+    parser.add_argument("--max-grasps", type=int, default=None,
+                        help="each scene's grasps drawn at random down to this many (default: all)")
     parser.add_argument("--summary", type=Path,
                         help="also write the summary here (docs/results/dgi_dataset_summary.json)")
     args = parser.parse_args(argv)
 
     objects = ([get_object(o) for o in args.objects.split(",")] if args.objects
                else list(load_library().values()))
+    if args.max_grasps is not None and args.max_grasps < 1:
+        parser.error(f"--max-grasps must be ≥ 1, got {args.max_grasps}")
     if args.object_mass < 0:
         parser.error(f"--object-mass must be ≥ 0 kg, got {args.object_mass}")
     episode = EpisodeConfig(object_mass=args.object_mass)
@@ -128,7 +132,8 @@ def collect(argv=None) -> int:
                      f"{', '.join(f'{m:g}' for m in sorted(mixed))} (0: the objects' own masses), "
                      f"not {args.object_mass:g}: choose another --out")
     jobs, through_table = make_jobs(objects, seed=args.seed, batch=args.batch,
-                                    sampling=SamplingConfig(), episode=episode)
+                                    sampling=SamplingConfig(max_grasps=args.max_grasps),
+                                    episode=episode)
     n_grasps = sum(len(j.payload["grasps"]) for j in jobs)
     done = finished_jobs(args.out)
     print(f"{len(objects)} objects, {n_grasps} grasps in {len(jobs)} jobs "

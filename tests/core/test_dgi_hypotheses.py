@@ -8,15 +8,21 @@ import pytest
 
 from tg_drake.errors import GraspingError
 from tg_drake.grasping.dgi import FINGERTIP_Y, GRIPPER_BASE_Y, PAD_CENTER_Y, depth_images
-from tg_drake.grasping.hypotheses import (
-    BODY_BOX,
-    GRASP_INSET,
-    box_grasps,
-    clears_plane,
-    perturb_grasps,
-    retreat_above_plane,
-    surface_grasps,
-)
+from tg_drake.grasping.expansion import ExpansionConfig, lowest_point, retreat_above_table
+from tg_drake.grasping.hypotheses import GRASP_INSET, box_grasps, perturb_grasps, surface_grasps
+from tg_drake.robot import WSG_BODY_CENTRE_G, WSG_BODY_SIZE
+
+BODY_BOX = (np.array(WSG_BODY_CENTRE_G), np.array(WSG_BODY_SIZE))
+
+
+def clears_plane(X, plane_z, *, approach_distance, clearance=0.003):
+    return lowest_point(X, approach_distance) >= plane_z + clearance
+
+
+def retreat_above_plane(X, plane_z, *, approach_distance, clearance, max_retreat):
+    return retreat_above_table(X, plane_z, approach_distance=approach_distance,
+                               config=ExpansionConfig(table_clearance=clearance,
+                                                      max_retreat=max_retreat))
 
 
 def assert_rigid(X):

@@ -1,5 +1,5 @@
 """The feasibility core on arrays: collision of the gripper's boxes, the hold's contact mechanics,
-the hold model, and the executed poses."""
+the hold model (the executed poses: test_expansion.py)."""
 
 import numpy as np
 import pytest
@@ -8,7 +8,6 @@ from tg_drake.grasping.feasibility import (
     FEATURES,
     GRAVITY,
     FeasibilityConfig,
-    approach_variants,
     box_signed_distance,
     collision,
     grasp_feasibility,
@@ -166,28 +165,3 @@ def test_a_colliding_pose_gets_no_hold():
     assert f.reasons[0].startswith("collision")
 
 
-def test_approach_variants_tilt_a_side_grasp_down_about_its_grasp_point():
-    X = np.eye(4)  # approach +y_W: horizontal
-    X[:3, 3] = [0.5, 0.0, 0.2]
-    variants = approach_variants(X, CONFIG, table_z=0.0)
-    assert len(variants) == 1 + len(CONFIG.approach_tilts)
-    p = X[:3, 3] + X[:3, 1] * WSG_GRASP_POINT_G[1]
-    for V, tilt in zip(variants[1:], CONFIG.approach_tilts, strict=True):
-        np.testing.assert_allclose(V[:3, 3] + V[:3, 1] * WSG_GRASP_POINT_G[1], p, atol=1e-12)
-        assert np.degrees(np.arcsin(-V[2, 1])) == pytest.approx(tilt)
-
-
-def test_a_steep_grasp_far_out_is_also_offered_leaning_back_towards_the_robot():
-    X = top_down((0.85, 0.0, 0.05))  # closing along x_W, towards the robot at the origin
-    X[:3, :3] = np.column_stack([[0, 1, 0], [0, 0, -1], [-1, 0, 0]])  # x_G = y_W: across
-    X[:3, 3] = np.array([0.85, 0.0, 0.05]) - X[:3, 1] * WSG_GRASP_POINT_G[1]
-    variants = approach_variants(X, CONFIG, table_z=-1.0)
-    assert len(variants) == 1 + len(CONFIG.top_tilts)
-    p = X[:3, 3] + X[:3, 1] * WSG_GRASP_POINT_G[1]
-    for V, tilt in zip(variants[1:], CONFIG.top_tilts, strict=True):
-        np.testing.assert_allclose(V[:3, 3] + V[:3, 1] * WSG_GRASP_POINT_G[1], p, atol=1e-12)
-        np.testing.assert_allclose(V[:3, 0], X[:3, 0], atol=1e-12)  # the same closing axis
-        assert -V[0, 1] < 0.0  # the wrist (−y_G) leans back towards the robot
-        assert np.degrees(np.arccos(-V[2, 1])) == pytest.approx(tilt)
-    # Closing towards the robot, the wrist cannot lean back about the closing axis.
-    assert len(approach_variants(top_down((0.85, 0.0, 0.05)), CONFIG, table_z=-1.0)) == 1

@@ -8,7 +8,7 @@ import pytest
 from grasp_helpers import GRASP_POINT, grasp_pose
 from pydrake.math import RigidTransform, RotationMatrix
 
-from tg_drake.grasping import feasibility
+from tg_drake.grasping.expansion import ExpansionConfig, retreat_above_table
 from tg_drake.planning.ik import CONSTRAINT_TOLERANCE, clearance, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.planner import (
     TABLE_CLEARANCE,
@@ -314,8 +314,11 @@ def test_the_retreat_backs_out_along_the_approach_at_the_place():
 
 
 def clear_of_table(X_WG, table_z):
-    """The feasibility stage's table clearance with the planner's TABLE_CLEARANCE."""
-    return feasibility.clear_of_table(X_WG, table_z, TABLE_CLEARANCE)
+    """X_WG moved back above the table by the rule of the scored poses
+    (tg_drake.grasping.expansion), clearing it by the planner's TABLE_CLEARANCE."""
+    config = ExpansionConfig(table_clearance=TABLE_CLEARANCE, max_retreat=np.inf)
+    moved, ok = retreat_above_table(X_WG, table_z, approach_distance=0.0, config=config)
+    return moved[0] if ok[0] else None
 
 
 def test_part_wider_than_the_opening_is_infeasible():

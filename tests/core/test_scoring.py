@@ -11,6 +11,10 @@ P_LOCAL = np.array([0.5, 0.8, 0.7, 0.9])  # per hypothesis, in the object's orde
 PARTS = np.array([1, 3, 1, 0])  # middle, handle, middle, top
 
 
+# Straight down over the robot's base: no approach variant (it cannot lean back towards it).
+TOP_DOWN = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0.5], [0, 0, 0, 1]])
+
+
 class FixedModel:
     """A stand-in for the DGI model: P(grasp | local shape) given per hypothesis."""
 
@@ -24,8 +28,10 @@ def scene():
         p_W=np.zeros((10, 3)), n_W=np.zeros((10, 3)), labels=np.zeros(10, int),
         visible=np.ones(10, bool), X_WO=np.eye(4), extents=np.full(3, 0.1), pose="upright",
         pose_likelihood={"upright": 1.0}, part_probabilities={}, part_boxes={},
-        pregrasp_X_WG=np.tile(np.eye(4), (4, 1, 1)), pregrasp_parts=PARTS)
-    return SceneDescription(objects=[obj], X_WT=np.eye(4))
+        pregrasp_X_WG=np.tile(TOP_DOWN, (4, 1, 1)), pregrasp_parts=PARTS)
+    X_WT = np.eye(4)
+    X_WT[2, 3] = -1.0  # the table far below: no pose moves back, none is dropped
+    return SceneDescription(objects=[obj], X_WT=X_WT)
 
 
 SEMANTICS = GraspSemantics(category={}, task={}, part={"middle": 0.9, "top": 0.1},
@@ -56,3 +62,16 @@ def test_unknown_selection_or_part_is_refused():
         rank_grasps(scene(), SEMANTICS, FixedModel(), selection="best")
     with pytest.raises(GraspingError, match="unknown part 'lid'"):
         rank_grasps(scene(), SEMANTICS, FixedModel(), selection="one_part", part="lid")
+
+
+def test_an_executed_pose_is_matched_to_the_scored_pose_it_is():
+    from tg_drake.grasping.expansion import tilted
+    from tg_drake.grasping.scoring import scored_pose_match
+
+    ranked = rank_grasps(scene(), SEMANTICS, FixedModel())
+    same = scored_pose_match(ranked.X_WG[2].copy(), ranked)
+    assert same["same"] and same["offset_m"] == 0.0 and same["p_local"] == ranked.p_local[0]
+    # The same hypothesis tilted by 10° about its grasp point (what the feasibility stage used to
+    # execute): not a pose the DGI scored.
+    other = scored_pose_match(tilted(ranked.X_WG[0], np.deg2rad(10.0)), ranked)
+    assert not other["same"] and np.degrees(other["angle_rad"]) == pytest.approx(10.0)

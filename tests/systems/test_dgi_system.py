@@ -211,3 +211,55 @@ def test_new_semantics_rerank_without_rescoring_the_shapes(model):
         context, SceneDescription(objects=[cylinder_object(poses[:1], parts[:1])],
                                   X_WT=np.eye(4), target=0))
     assert len(port.Eval(context).score) == 1 and calls == [2, 1]
+
+
+def test_scores_the_poses_that_will_be_executed_and_feasibility_passes_them_on(model):
+    """scoring → feasibility in a small diagram: the scorer turns each hypothesis into the poses
+    that may be executed (`executed_poses`: variants, moved back above the table), scores each of
+    them by its own DGI, and feasibility hands exactly those poses on."""
+    from tg_drake.grasping.expansion import ExpansionConfig, executed_poses
+    from tg_drake.grasping.feasibility import FeasibilityConfig
+    from tg_drake.systems.feasibility_system import GraspFeasibility
+
+    side = np.eye(4)  # from −y_W towards the cylinder's middle, closing along x_W: 4 variants
+    side[:3, 3] = np.array([0.5, 0.0, 0.06]) - [0.0, PAD_CENTER_Y, 0.0]
+    low = top_down([0.5, 0, 0.03])  # its pad tips 11 mm under the table top: moved back
+    hypotheses = np.stack([side, low])
+    target = cylinder_object(hypotheses, [part_index("middle"), part_index("top")])
+    scene = SceneDescription(objects=[target], X_WT=np.eye(4), target=0)
+    semantics = GraspSemantics(category={"cup": 1.0}, task={"pass": 1.0},
+                               part={"top": 0.5, "middle": 0.5}, given_task="pass")
+    expansion = ExpansionConfig()
+    builder = DiagramBuilder()
+    scoring = builder.AddSystem(DgiScoringSystem(model, expansion=expansion, approach=0.1))
+    feasibility = builder.AddSystem(GraspFeasibility(FeasibilityConfig(), approach=0.1))
+    builder.Connect(scoring.get_ranked_grasps_output_port(),
+                    feasibility.GetInputPort("ranked_grasps"))
+    builder.ExportInput(scoring.get_scene_description_input_port(), "scene")
+    builder.ExportInput(feasibility.GetInputPort("scene_description"), "scene_f")
+    builder.ExportInput(scoring.get_grasp_semantics_input_port(), "semantics")
+    builder.ExportInput(feasibility.GetInputPort("grasp_semantics"), "semantics_f")
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    for name, value in (("scene", scene), ("scene_f", scene), ("semantics", semantics),
+                        ("semantics_f", semantics)):
+        diagram.GetInputPort(name).FixValue(context, value)
+    scored = scoring.get_ranked_grasps_output_port().Eval(
+        scoring.GetMyContextFromRoot(context))
+
+    poses, source = executed_poses(hypotheses, 0.0, approach_distance=0.1, config=expansion)
+    assert np.bincount(source).tolist() == [1 + len(expansion.approach_tilts), 1]
+    assert poses[-1][2, 3] > low[2, 3]  # the low one moved up its approach
+    assert len(scored.score) == len(poses)
+    for k in range(len(poses)):
+        i = int(np.flatnonzero(np.all(np.isclose(poses, scored.X_WG[k]), axis=(1, 2)))[0])
+        assert scored.source[k] == source[i]
+        # Each pose's P(grasp | local shape) is its own DGI's, not its hypothesis'.
+        assert scored.p_local[k] == pytest.approx(model.p_grasp(target.p_W, poses[i:i + 1])[0])
+    assert len(set(np.round(scored.p_local, 9))) > 1  # the variants look different to the DGI
+    assert np.all(np.diff(scored.score) <= 0)  # best first
+    out = feasibility.get_ranked_grasps_output_port().Eval(
+        feasibility.GetMyContextFromRoot(context))
+    assert len(out.score) == len(scored.score)
+    for X in out.X_WG:  # every pose the planner may take is one the DGI scored
+        assert np.any(np.all(np.isclose(scored.X_WG, X, atol=0), axis=(1, 2)))

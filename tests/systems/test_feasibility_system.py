@@ -73,9 +73,10 @@ def test_feasibility_system_rules_out_the_pose_that_would_cut_a_neighbour(scene,
         category={"can": 1.0}, task={}, part={"middle": 1.0}, given_task=None))
     system.GetInputPort("ranked_grasps").FixValue(sc, candidates())
     out: GraspCandidates = system.get_ranked_grasps_output_port().Eval(sc)
-    # Each hypothesis with its approach variants (top-down: upright and two tilts each, where
-    # the wrist can lean towards the robot).
-    assert len(out.score) >= 2 and len(out.source) == len(out.score)
+    # The poses as scored, none added or moved (the scoring stage made them).
+    assert len(out.score) == 2 and len(out.source) == len(out.score)
+    for k, i in enumerate(out.source):
+        np.testing.assert_array_equal(out.X_WG[k], candidates().X_WG[i])
     assert out.p_hold is not None and len(out.feasibility_reasons) == len(out.score)
     along = out.source == 0
     assert np.all(out.score[along] == 0.0)

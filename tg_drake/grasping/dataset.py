@@ -6,10 +6,11 @@ one of its poses. For each scene:
 - `scene_cloud`: the object's surface sampled at the perception's voxel size (4 mm) with 1 mm
   Gaussian noise, in the world — what the DGI sees (perception delivers clouds of that density);
 - `scene_grasps`: the grasps to execute — the paper's pre-grasp hypotheses on the ground-truth part
-  boxes (two per face), perturbed copies of them, plus random grasps at surface points; a grasp
-  whose gripper would pass through the table is moved back along its approach when up to 5 cm
-  suffice (flat objects are grasped with the fingertips just above the table), else left out (the
-  DGI of the object alone cannot see the table);
+  boxes (two per face) and perturbed copies of them, each turned into the poses that may be
+  executed by the rule inference uses (`tg_drake.grasping.expansion.executed_poses`: its approach
+  variants, each moved back above the table or left out — the DGI of the object alone cannot see
+  the table), plus random grasps at surface points (moved back above the table by the same rule,
+  without variants); optionally `max_grasps` of them drawn at random;
 - `training_set`: features and labels from the executed grasps (JSON Lines from
   tools/collect_grasps.py), the clouds regenerated from the same seeds.
 
@@ -20,18 +21,14 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from tg_drake.grasping.dgi import PAD_CENTER_Y, DgiConfig, dgi_features
-from tg_drake.grasping.hypotheses import (
-    box_grasps,
-    perturb_grasps,
-    retreat_above_plane,
-    surface_grasps,
-)
+from tg_drake.grasping.expansion import ExpansionConfig, executed_poses
+from tg_drake.grasping.hypotheses import box_grasps, perturb_grasps, surface_grasps
 from tg_drake.objects import LibraryObject, get_object, sample_surface
 
 KINDS = ("box", "perturbed", "random")
@@ -48,9 +45,12 @@ class SamplingConfig:
     angle_std: float = 0.2  # perturbation of the orientation, per axis-angle component [rad].
     cloud_spacing: float = 0.004  # surface sample spacing [m] (perception's voxel size).
     cloud_noise: float = 0.001  # Gaussian noise on each point, per axis [m].
-    approach_distance: float = 0.05  # the episode's approach [m], for the table check.
-    table_clearance: float = 0.003  # the gripper's boxes stay this far above the table [m].
-    max_retreat: float = 0.05  # a grasp may move this far back along its approach to clear it [m].
+    approach_distance: float = 0.05  # the episode's approach [m], for the table check
+    # (simulation.episode.EpisodeConfig.approach_distance).
+    expansion: ExpansionConfig = field(default_factory=ExpansionConfig)  # hypothesis → the poses
+    # that may be executed: inference's rule (PipelineConfig.expansion's default).
+    max_grasps: int | None = None  # a scene's grasps drawn at random down to this many (None:
+    # all of them): a collection within a time budget.
 
 
 def scene_rng(seed: int, object_id: str, pose: str, purpose: str) -> np.random.Generator:
@@ -94,6 +94,8 @@ class SceneGrasps:
     parts: np.ndarray  # (M,) int part label of the surface point nearest to the grasp point.
     n_through_table: int  # box and perturbed hypotheses left out: the gripper would pass through
     # the table.
+    hypotheses: np.ndarray | None = None  # (H, 4, 4) the part-box hypotheses before the rule
+    # (`executed_poses`) made the box grasps of them.
 
 
 def scene_grasps(obj: LibraryObject, pose: str, *, seed: int,
@@ -110,19 +112,25 @@ def scene_grasps(obj: LibraryObject, pose: str, *, seed: int,
                                position_std=config.position_std, angle_std=config.angle_std)
     p_W = p_O @ X_WO[:3, :3].T + X_WO[:3, 3]
     n_W = n_O @ X_WO[:3, :3].T
+    # The table top is z_W = 0 (the resting pose's frame T is the world's).
+    hypotheses = np.concatenate([box, perturbed])
+    X_h, source = executed_poses(hypotheses, 0.0, approach_distance=config.approach_distance,
+                                 config=config.expansion)
+    n_through_table = len(hypotheses) - len(np.unique(source))
     # Random grasps: drawn 32 times over, the first n_random that can clear the table are kept.
-    random = surface_grasps(p_W, n_W, 32 * config.n_random, rng)
-    X_WG = np.concatenate([box, perturbed, random])
-    kinds = np.array(["box"] * len(box) + ["perturbed"] * len(perturbed)
-                     + ["random"] * len(random))
-    X_WG, keep = retreat_above_plane(X_WG, 0.0, approach_distance=config.approach_distance,
-                                     clearance=config.table_clearance,
-                                     max_retreat=config.max_retreat)
-    n_through_table = int(np.sum(~keep[kinds != "random"]))
-    keep[np.flatnonzero(keep & (kinds == "random"))[config.n_random:]] = False
+    X_r, _ = executed_poses(surface_grasps(p_W, n_W, 32 * config.n_random, rng), 0.0,
+                            approach_distance=config.approach_distance, config=config.expansion,
+                            variants=False)
+    X_r = X_r[:config.n_random]
+    X_WG = np.concatenate([X_h, X_r])
+    kinds = np.array(["box" if j < len(box) else "perturbed" for j in source]
+                     + ["random"] * len(X_r))
+    if config.max_grasps is not None and len(X_WG) > config.max_grasps:
+        keep = np.sort(rng.choice(len(X_WG), size=config.max_grasps, replace=False))
+        X_WG, kinds = X_WG[keep], kinds[keep]
     grasp_points = X_WG[:, :3, 3] + PAD_CENTER_Y * X_WG[:, :3, 1]
     parts = labels[cKDTree(p_W).query(grasp_points)[1]]
-    return SceneGrasps(obj.id, pose, X_WO, X_WG[keep], kinds[keep], parts[keep], n_through_table)
+    return SceneGrasps(obj.id, pose, X_WO, X_WG, kinds, parts, n_through_table, box)
 
 
 def library_scenes(objects: Iterable[LibraryObject]) -> list[tuple[LibraryObject, str]]:

@@ -29,7 +29,7 @@ Arrays in, arrays out: no Drake.
 
 import functools
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from importlib.resources import files
 from pathlib import Path
 
@@ -84,14 +84,6 @@ class FeasibilityConfig:
     # base rate on held-out objects (Brier 0.246 against 0.250, tg_drake/data/
     # hold_model.report.json), so it is reported (result.json grasp.p_hold), not acted on.
     model: str = ""  # a hold-model JSON file (tools/fit_hold_model.py); "" = the shipped one.
-    approach_tilts: list[float] = field(default_factory=lambda: [10.0, 20.0, 35.0])  # [deg] a
-    # side grasp (approach within 30° of horizontal) is also offered tilted downwards about its
-    # closing axis through its grasp point by these angles: the fingers still close across the
-    # same part, and the wrist rises clear of the table.
-    top_tilts: list[float] = field(default_factory=lambda: [15.0, 30.0])  # [deg] a steep grasp is
-    # also offered with its wrist tilted back towards the robot about the closing axis.
-    pad_table_clearance: float = 0.004  # [m] a pose whose open pads reach under the table top is
-    # moved back along its approach until they clear it by this much (`clear_of_table`).
 
     def validate(self, where: str = "feasibility") -> None:
         for name in ("opening", "grip_force", "contact_depth", "patch_cell", "pad_friction",
@@ -441,67 +433,6 @@ def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: n
     return Feasibility(np.array(p), tuple(reasons), tuple(holds), tuple(hits))
 
 
-# --- the poses that will be executed ------------------------------------------------------------
-
-# The open finger pads in G: the 8 outer corners of the pair [m].
-PAD_CORNERS_G = np.array([c + s * np.asarray(size) / 2 for c, size in wsg_pad_boxes()
-                          for s in np.array(np.meshgrid(*[(-1.0, 1.0)] * 3)).reshape(3, -1).T])
-
-
-def clear_of_table(X_WG: np.ndarray, table_z: float, clearance: float) -> np.ndarray | None:
-    """X_WG moved back along its approach until the open pads clear the table top by
-    `clearance` [m]. None if moving back cannot help (an approach that does not point down)."""
-    p_W = X_WG[:3, :3] @ PAD_CORNERS_G.T + X_WG[:3, 3:4]
-    deficit = table_z + clearance - p_W[2].min()
-    if deficit <= 0:
-        return X_WG
-    down = -X_WG[2, 1]  # how much the approach +y_G points down
-    if down < 0.2:
-        return None
-    X = X_WG.copy()
-    X[:3, 3] -= X_WG[:3, 1] * (deficit / down)
-    return X
-
-
-def _tilted(X_WG: np.ndarray, angle: float) -> np.ndarray:
-    """X_WG turned about its closing axis x_G through its grasp point by `angle` [rad]."""
-    c, s_ = np.cos(angle), np.sin(angle)
-    R = X_WG[:3, :3] @ np.array([[1, 0, 0], [0, c, -s_], [0, s_, c]])
-    X = np.eye(4)
-    X[:3, :3] = R
-    X[:3, 3] = X_WG[:3, 3] + GRASP_DEPTH * X_WG[:3, 1] - GRASP_DEPTH * R[:, 1]
-    return X
-
-
-def approach_variants(X_WG: np.ndarray, config: FeasibilityConfig, *, table_z: float = 0.0
-                      ) -> list[np.ndarray]:
-    """X_WG itself, then, for a side grasp (approach within 30° of horizontal), X_WG tilted
-    downwards about its closing axis through the grasp point by each of `config.approach_tilts`,
-    and for a steep grasp, tilted back towards the robot (at the world origin) by each of
-    `config.top_tilts`; each moved back along its approach when its open pads would reach under
-    the table (`clear_of_table`), and dropped when that cannot help."""
-    variants = [X_WG]
-    y = X_WG[:3, 1]
-    p_grasp = X_WG[:3, 3] + GRASP_DEPTH * y
-    if abs(y[2]) > np.sin(np.deg2rad(30.0)):
-        towards_robot = -p_grasp[:2] / max(np.linalg.norm(p_grasp[:2]), 1e-9)
-        for tilt in np.deg2rad(config.top_tilts):
-            # the sign whose body (−y_G) leans most towards the robot
-            lean, sign = max(((-_tilted(X_WG, s * tilt)[:2, 1] @ towards_robot, s)
-                              for s in (1.0, -1.0)), key=lambda v: v[0])
-            if lean > 1e-6:
-                variants.append(_tilted(X_WG, sign * tilt))
-    else:
-        for tilt in np.deg2rad(config.approach_tilts):
-            for sign in (1.0, -1.0):
-                X = _tilted(X_WG, sign * tilt)
-                if X[2, 1] < y[2]:  # the approach points further down
-                    variants.append(X)
-                    break
-    cleared = (clear_of_table(V, table_z, config.pad_table_clearance) for V in variants)
-    return [X for X in cleared if X is not None]
-
-
 # --- the stage on a scene -------------------------------------------------------------------
 
 
@@ -509,11 +440,11 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
                       category: dict[str, float] | None, approach: float,
                       config: FeasibilityConfig, model: HoldModel | None = None
                       ) -> GraspCandidates:
-    """The candidates as they will be executed: each hypothesis with its approach variants
-    (`approach_variants`), each pose with P(hold) and the score P(part | task) · P(grasp | local
-    shape) · P(hold) (0 with a reason where infeasible), best first. `category`: the logic's
-    category distribution (the mass's density prior); `approach` [m]: the planner's pre-grasp
-    distance (the approach swept for collisions)."""
+    """The candidates (the poses that may be executed: the scoring stage made and scored them,
+    `tg_drake.grasping.expansion`), each with P(hold) and the score P(part | task) · P(grasp |
+    local shape) · P(hold) (0 with a reason where infeasible), best first; the poses are not
+    changed. `category`: the logic's category distribution (the mass's density prior);
+    `approach` [m]: the planner's pre-grasp distance (the approach swept for collisions)."""
     m = len(candidates.score)
     if m == 0 or not 0 <= candidates.target < len(scene.objects):
         return GraspCandidates(np.zeros((0, 4, 4)), np.zeros(0, int), np.zeros(0), np.zeros(0),
@@ -523,19 +454,14 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
     others = [o.p_W for i, o in enumerate(scene.objects) if i != candidates.target]
     others_p_W = np.concatenate(others) if others else np.zeros((0, 3))
     table_z = float(scene.X_WT[2, 3])
-    poses, source = [], []
-    for i in range(m):
-        variants = approach_variants(np.asarray(candidates.X_WG[i], float), config,
-                                     table_z=table_z)
-        poses += variants
-        source += [i] * len(variants)
-    source = np.array(source, int)
-    X_WG = np.array(poses).reshape(-1, 4, 4)
+    source = (np.arange(m) if candidates.source is None
+              else np.asarray(candidates.source, int))
+    X_WG = np.asarray(candidates.X_WG, float).reshape(-1, 4, 4)
     f = grasp_feasibility(X_WG, target_p_W=target.p_W, others_p_W=others_p_W, table_z=table_z,
                           approach=approach, category=category, config=config, model=model)
-    p_part = np.asarray(candidates.p_part, float)[source]
-    p_local = np.asarray(candidates.p_local, float)[source]
-    parts = np.asarray(candidates.parts, int)[source]
+    p_part = np.asarray(candidates.p_part, float)
+    p_local = np.asarray(candidates.p_local, float)
+    parts = np.asarray(candidates.parts, int)
     ok = np.array([not r for r in f.reasons], bool)
     score = np.where(ok, p_part * p_local * (f.p_hold if config.rank_by_hold else 1.0), 0.0)
     order = np.argsort(-score, kind="stable")

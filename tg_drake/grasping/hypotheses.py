@@ -9,9 +9,10 @@ grasp point at y_G = PAD_CENTER_Y). All functions are vectorised and take their 
 - `perturb_grasps`: hypotheses moved and turned a little, as an imprecise perception would.
 - `surface_grasps`: random hypotheses at random surface points, approaching roughly against the
   normal, turned at random about it.
-- `clears_plane`: whether the gripper (body and open fingers, along its approach) stays above a
-  plane — grasps through the table are left out, since a DGI of the object alone cannot see it;
-  `retreat_above_plane` first moves a grasp back along its approach when a little suffices.
+
+The table is not theirs to judge: `tg_drake.grasping.expansion.executed_poses` turns a hypothesis
+into the poses that may be executed (approach variants, moved back above the table), for the
+training data and for inference alike.
 """
 
 from __future__ import annotations
@@ -20,11 +21,7 @@ import numpy as np
 
 from tg_drake.errors import GraspingError
 from tg_drake.grasping.dgi import PAD_CENTER_Y
-from tg_drake.robot import WSG_BODY_CENTRE_G, WSG_BODY_SIZE, wsg_pad_boxes
 
-# Collision boxes of the WSG in G, fingers fully open: (centre, full size) [m].
-BODY_BOX = (np.array(WSG_BODY_CENTRE_G), np.array(WSG_BODY_SIZE))
-PAD_BOXES = wsg_pad_boxes()
 # How far behind the face the grasp point goes on a part thicker than the pads reach [m]:
 # the pads then overlap the part by 0.041 + 0.025 = 66 mm of their 82 mm length.
 GRASP_INSET = 0.025
@@ -115,41 +112,3 @@ def surface_grasps(p_W: np.ndarray, n_W: np.ndarray, count: int, rng: np.random.
     x /= np.linalg.norm(x, axis=1, keepdims=True)
     grasp_point = p_W[i] + y * rng.uniform(0, max_depth, size=count)[:, None]
     return _frames(x, y, grasp_point - PAD_CENTER_Y * y)
-
-
-def _lowest_point(X_WG: np.ndarray, approach_distance: float) -> np.ndarray:
-    """(M,) lowest z_W of the gripper's boxes (body and open pads) at the grasp pose and at the
-    approach start (approach_distance back along −y_G; the path between is a straight line, so
-    the two ends bound it)."""
-    corners = np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])).reshape(3, -1).T
-    p_G = np.concatenate([c + corners * size for c, size in (BODY_BOX, *PAD_BOXES)])  # (24, 3)
-    lowest = np.full(len(X_WG), np.inf)
-    for back in (0.0, approach_distance):
-        q = p_G - np.array([0.0, back, 0.0])
-        z = np.einsum("mj,nj->mn", X_WG[:, 2, :3], q) + X_WG[:, 2, 3][:, None]
-        lowest = np.minimum(lowest, z.min(axis=1))
-    return lowest
-
-
-def clears_plane(X_WG: np.ndarray, plane_z: float, *, approach_distance: float,
-                 clearance: float = 0.003) -> np.ndarray:
-    """(M,) True where the gripper's boxes (body and open pads) stay `clearance` [m] above the
-    plane z_W = plane_z at the grasp pose and all along its approach."""
-    X_WG = np.asarray(X_WG, dtype=float).reshape(-1, 4, 4)
-    return _lowest_point(X_WG, approach_distance) >= plane_z + clearance
-
-
-def retreat_above_plane(X_WG: np.ndarray, plane_z: float, *, approach_distance: float,
-                        clearance: float = 0.003, max_retreat: float = 0.05):
-    """Grasps moved back along −y_G just enough to clear the plane (as `clears_plane`), if that
-    takes at most `max_retreat` [m]: a flat object on the table is then grasped with the
-    fingertips just above the table. Returns (moved X_WG (M, 4, 4), (M,) bool: clears now)."""
-    X_WG = np.asarray(X_WG, dtype=float).reshape(-1, 4, 4).copy()
-    short = plane_z + clearance - _lowest_point(X_WG, approach_distance)
-    rise_per_metre = -X_WG[:, 2, 1]  # moving back along −y_G raises every point by −y_G,z
-    with np.errstate(divide="ignore", invalid="ignore"):
-        retreat = np.where(short <= 0, 0.0, short / rise_per_metre)
-    ok = (short <= 0) | ((rise_per_metre > 1e-6) & (retreat <= max_retreat))
-    retreat = np.where(ok, retreat, 0.0)
-    X_WG[:, :3, 3] -= retreat[:, None] * X_WG[:, :3, 1]
-    return X_WG, ok

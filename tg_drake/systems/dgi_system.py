@@ -6,8 +6,14 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
+from tg_drake.grasping.expansion import ExpansionConfig
 from tg_drake.grasping.model import DgiGraspModel, load_default_model
-from tg_drake.grasping.scoring import check_selection, local_probabilities, rank_grasps
+from tg_drake.grasping.scoring import (
+    DEFAULT_APPROACH,
+    check_selection,
+    local_probabilities,
+    rank_grasps,
+)
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 
@@ -22,12 +28,16 @@ class DgiScoringSystem(LeafSystem):
         output_ports:
         - ranked_grasps
 
-    Scores the target object's pre-grasp hypotheses by part and local shape. For the object that
+    Scores the poses that may be executed by part and local shape. For the object that
     ``grasp_semantics`` (a `GraspSemantics`) is about, every pre-grasp hypothesis of
-    ``scene_description`` (a `SceneDescription`) gets P(grasp | local shape) from the DGI
-    features of the object's cloud in the WSG's closing volume and the RBF SVM + Platt sigmoid,
-    and the logic's P(part | task) of its part. ``ranked_grasps`` (a `GraspCandidates`) holds
-    them all with score = P(part | task) · P(grasp | local shape), best first.
+    ``scene_description`` (a `SceneDescription`) is turned into its approach variants, each moved
+    back above the table (`tg_drake.grasping.expansion.executed_poses`, the rule of the DGI's
+    training data; `expansion`, with the planner's approach distance `approach` [m]); each such
+    pose gets P(grasp | local shape) from the DGI features of the object's cloud in the WSG's
+    closing volume and the RBF SVM + Platt sigmoid, and the logic's P(part | task) of its part.
+    ``ranked_grasps`` (a `GraspCandidates`, `source`: each pose's hypothesis) holds them all with
+    score = P(part | task) · P(grasp | local shape), best first: the feasibility stage and the
+    planner take these poses as they are.
 
     P(grasp | local shape) depends on the scene alone: it is a cache entry on
     ``scene_description`` (for the object the logic reasons about, the scene's ``target``),
@@ -39,9 +49,12 @@ class DgiScoringSystem(LeafSystem):
     """
 
     def __init__(self, model: DgiGraspModel | None = None, *, selection: str = "pipeline",
-                 part: str | None = None):
+                 part: str | None = None, expansion: ExpansionConfig | None = None,
+                 approach: float = DEFAULT_APPROACH):
         super().__init__()
         check_selection(selection, part)
+        self._expansion = expansion or ExpansionConfig()
+        self._approach = float(approach)
         self._selection = selection
         self._part = part
         self._model = model if model is not None else load_default_model()
@@ -81,15 +94,18 @@ class DgiScoringSystem(LeafSystem):
         return self._ranked_port
 
     def p_local_cache_entry(self):
-        """The cache entry of P(grasp | local shape): (target, one value per hypothesis in the
-        order of its pregrasp_X_WG), or None when the scene's target is not one of its objects."""
+        """The cache entry of P(grasp | local shape): (target, one value per candidate pose in the
+        order of `scoring.candidate_poses`), or None when the scene's target is not one of its
+        objects."""
         return self._p_local
 
     def _calc_p_local(self, context, value):
         scene: SceneDescription = self._scene_port.Eval(context)
         target = scene.reasoning_target
         value.set_value(None if not 0 <= target < len(scene.objects) else
-                        (target, local_probabilities(scene, target, self._model)))
+                        (target, local_probabilities(scene, target, self._model,
+                                                     expansion=self._expansion,
+                                                     approach=self._approach)))
 
     def _calc_ranked_grasps(self, context, output):
         semantics: GraspSemantics = self._semantics_port.Eval(context)
@@ -97,4 +113,5 @@ class DgiScoringSystem(LeafSystem):
         p_local = cached[1] if cached is not None and cached[0] == semantics.target else None
         output.set_value(rank_grasps(self._scene_port.Eval(context), semantics, self._model,
                                      selection=self._selection, part=self._part,
-                                     p_local=p_local))
+                                     p_local=p_local, expansion=self._expansion,
+                                     approach=self._approach))
