@@ -177,7 +177,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     builder.Connect(task.get_output_port(), logic.GetInputPort("task"))
     scoring = builder.AddNamedSystem("dgi_scoring", DgiScoringSystem(
         load_model(config.scoring.model) if config.scoring.model else None,
-        selection=config.selection, part=getattr(config.scoring, "part", None)))
+        selection=config.selection, part=getattr(config.scoring, "part", None),
+        seed=getattr(config.scoring, "seed", 0)))
     builder.Connect(scene, scoring.GetInputPort("scene_description"))
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     scoring.GetInputPort("grasp_semantics"))

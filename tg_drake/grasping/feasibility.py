@@ -510,10 +510,10 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
                       config: FeasibilityConfig, model: HoldModel | None = None
                       ) -> GraspCandidates:
     """The candidates as they will be executed: each hypothesis with its approach variants
-    (`approach_variants`), each pose with P(hold) and the score P(part | task) · P(grasp | local
-    shape) · P(hold) (0 with a reason where infeasible), best first. `category`: the logic's
-    category distribution (the mass's density prior); `approach` [m]: the planner's pre-grasp
-    distance (the approach swept for collisions)."""
+    (`approach_variants`), each pose with P(hold) and the scorer's score (the pipeline's P(part |
+    task) · P(grasp | local shape)) · P(hold) (0 with a reason where infeasible), best first.
+    `category`: the logic's category distribution (the mass's density prior); `approach` [m]: the
+    planner's pre-grasp distance (the approach swept for collisions)."""
     m = len(candidates.score)
     if m == 0 or not 0 <= candidates.target < len(scene.objects):
         return GraspCandidates(np.zeros((0, 4, 4)), np.zeros(0, int), np.zeros(0), np.zeros(0),
@@ -537,10 +537,13 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
     p_local = np.asarray(candidates.p_local, float)[source]
     parts = np.asarray(candidates.parts, int)[source]
     ok = np.array([not r for r in f.reasons], bool)
-    score = np.where(ok, p_part * p_local * (f.p_hold if config.rank_by_hold else 1.0), 0.0)
+    # The scorer's score (P(part | task) · P(grasp | local shape) for the pipeline; the Local and
+    # one-part variants score otherwise), its approach variants sharing it.
+    scored = np.asarray(candidates.score, float)[source]
+    score = np.where(ok, scored * (f.p_hold if config.rank_by_hold else 1.0), 0.0)
     order = np.argsort(-score, kind="stable")
-    # Parts the logic and the shape allow, none of whose poses would hold (not for collisions).
-    viable = p_part * p_local > 0
+    # Parts the scorer allows, none of whose poses would hold (not for collisions).
+    viable = scored > 0
     unholdable = tuple(
         PART_LABELS[k] for k in np.unique(parts[viable])
         if not ok[viable & (parts == k)].any()

@@ -35,15 +35,17 @@ class DgiScoringSystem(LeafSystem):
 
     The model is the one shipped with the package unless `model` is given. `selection`
     "local_only" ranks by P(grasp | local shape) alone (the paper's Local baseline); "one_part"
-    ranks only the hypotheses of `part`, by P(grasp | local shape) (`rank_grasps`).
+    ranks only the hypotheses of `part`, by P(grasp | local shape) (`rank_grasps`); "random_part"
+    those of a part drawn with `seed`.
     """
 
     def __init__(self, model: DgiGraspModel | None = None, *, selection: str = "pipeline",
-                 part: str | None = None):
+                 part: str | None = None, seed: int = 0):
         super().__init__()
         check_selection(selection, part)
         self._selection = selection
         self._part = part
+        self._seed = seed
         self._model = model if model is not None else load_default_model()
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description",
@@ -97,4 +99,4 @@ class DgiScoringSystem(LeafSystem):
         p_local = cached[1] if cached is not None and cached[0] == semantics.target else None
         output.set_value(rank_grasps(self._scene_port.Eval(context), semantics, self._model,
                                      selection=self._selection, part=self._part,
-                                     p_local=p_local))
+                                     p_local=p_local, seed=self._seed))
