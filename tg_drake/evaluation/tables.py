@@ -400,9 +400,11 @@ def task_success(records) -> dict:
             failed: dict = defaultdict(int)
             for r in rs:
                 if not _task_success(r):
-                    t_out = (r.get("outcome") or {}).get("task_outcome")
-                    why = ((t_out or {}).get("detail") or (r.get("outcome") or {}).get("reason")
+                    o = r.get("outcome") or {}
+                    why = ((o.get("task_outcome") or {}).get("detail") or o.get("reason")
                            or r.get("error", "error"))
+                    if o.get("status") == "failed" and o.get("reason"):  # ended before the task
+                        why = f"run failed: {o['reason']}"
                     failed[" ".join(str(why).split())[:60]] += 1
             row["failures"] = dict(sorted(failed.items(), key=lambda kv: -kv[1]))
             out.setdefault(t, {})[v] = row
