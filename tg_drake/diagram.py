@@ -179,7 +179,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     scoring = builder.AddNamedSystem("dgi_scoring", DgiScoringSystem(
         load_model(config.scoring.model) if config.scoring.model else None,
         selection=config.selection, part=getattr(config.scoring, "part", None),
-        expansion=config.expansion, approach=config.planner.pregrasp_distance))
+        expansion=config.expansion, approach=config.planner.pregrasp_distance,
+        seed=getattr(config.scoring, "seed", 0)))
     builder.Connect(scene, scoring.GetInputPort("scene_description"))
     builder.Connect(logic.GetOutputPort("grasp_semantics"),
                     scoring.GetInputPort("grasp_semantics"))

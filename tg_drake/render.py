@@ -75,3 +75,72 @@ def main(args) -> int:
         plt.imsave(folder / "labels.png", labels_to_rgb(frame["label"]))
         print(f"{name}: wrote {folder}/rgb.png, depth.png, labels.png")
     return 0
+
+
+# -- A run's key frames (task.png, tg_drake.report) --------------------------------------------
+
+RECORD_PERIOD = 0.05  # [s] simulated time between the plant positions a run keeps for its pictures
+
+
+class PositionRecorder:
+    """The plant's positions at most every RECORD_PERIOD of simulated time, for the pictures of
+    a run (`record` is called from the simulator's monitor; it reads the state, changes nothing)."""
+
+    def __init__(self, plant):
+        self._plant = plant
+        self.times: list[float] = []
+        self.q: list[np.ndarray] = []
+
+    def record(self, root_context) -> None:
+        t = root_context.get_time()
+        if self.times and t < self.times[-1] + RECORD_PERIOD:
+            return
+        self.times.append(t)
+        self.q.append(np.array(self._plant.GetPositions(
+            self._plant.GetMyContextFromRoot(root_context))))
+
+    def at(self, t: float) -> np.ndarray:
+        """The positions recorded last at or before `t` (the first ones before the record)."""
+        if not self.times:
+            raise ValueError("no plant positions were recorded")
+        i = int(np.searchsorted(np.asarray(self.times), t, side="right")) - 1
+        return self.q[max(i, 0)]
+
+
+def key_times(plan, t_plan: float, t_end: float, task: str) -> list[tuple[str, float]]:
+    """The key frames of a task run [s of simulated time]: the grasp (the fingers closed), the
+    task's moment — the middle of the pour or the fill, the hand-over, else the placed pose —
+    and the end (`t_end`); `plan`'s times are offset by `t_plan`, none after `t_end`."""
+    keys = [("grasp", t_plan + plan.t_grasp_closed)]
+    handover = getattr(plan, "t_handover", None)  # the pass's (receiver closes, robot lets go)
+    if plan.t_pour is not None:
+        keys.append(("pour" if task == "pourOut" else "fill",
+                     t_plan + 0.5 * (plan.t_pour[0] + plan.t_pour[1])))
+    elif handover is not None:
+        keys.append(("hand-over", t_plan + handover[0]))
+    else:
+        keys.append(("placed", t_plan + plan.t_place_done))
+    keys.append(("end", t_end))
+    return [(name, min(t, t_end)) for name, t in keys]
+
+
+def render_key_frames(scenario, recorder: PositionRecorder, keys, camera: str
+                      ) -> list[tuple[str, float, np.ndarray]]:
+    """(name, t, (H, W, 3) RGB) per key frame, seen through `camera` in a station of its own in
+    which the contents' spheres and the dispenser are visible (the run's cameras, perception's,
+    never see them), its plant set to the run's recorded positions."""
+    from tg_drake.station import make_station  # start-up: --help imports this module; pydrake
+
+    diagram, station = make_station(scenario, contents_visible=True)
+    context = diagram.CreateDefaultContext()
+    plant_context = station.plant.GetMyContextFromRoot(context)
+    port = diagram.GetOutputPort(f"{camera}.rgb_image")
+    frames = []
+    for name, t in keys:
+        q = recorder.at(t)
+        if q.shape != (station.plant.num_positions(),):
+            raise ValueError(f"the pictures' station has {station.plant.num_positions()} "
+                             f"positions, the run recorded {q.shape[0]}")
+        station.plant.SetPositions(plant_context, q)
+        frames.append((name, t, np.array(port.Eval(context).data[:, :, :3])))
+    return frames

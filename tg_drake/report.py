@@ -1,5 +1,6 @@
 """What a run writes: result.json (assembled from port values), the one-screen summary and the
-pictures (the camera view, the part-coloured perceived cloud, the chosen grasp).
+pictures (the camera view, the part-coloured perceived cloud, the chosen grasp, and for a task run
+its key frames: task.png).
 
 `write` puts result.json down first and the pictures after it: a picture that fails is a warning,
 never a lost result.
@@ -9,6 +10,7 @@ from __future__ import annotations
 
 import json
 import sys
+import textwrap
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -163,6 +165,8 @@ class Pictures:
 
     stages: Stages
     X_WG: np.ndarray | None = None  # the chosen grasp pose, if a plan was made
+    task_frames: object = None  # a task run with a plan: () → [(name, t [s], (H, W, 3) RGB)],
+    # its key frames rendered from the camera (tg_drake.render.render_key_frames)
 
 
 def write(folder: Path, result: dict, pictures: Pictures | None) -> list[str]:
@@ -187,6 +191,10 @@ def write(folder: Path, result: dict, pictures: Pictures | None) -> list[str]:
                                                          folder / "grasp.png",
                                                          title=_grasp_title(result),
                                                          seed=seed)))
+    if pictures.task_frames is not None:
+        jobs.append(("task.png", lambda: save_task_png(pictures.task_frames(),
+                                                       folder / "task.png",
+                                                       title=_task_title(result))))
     for name, job in jobs:
         try:
             job()
@@ -197,6 +205,40 @@ def write(folder: Path, result: dict, pictures: Pictures | None) -> list[str]:
         result["warnings"] = list(result.get("warnings", [])) + warnings
         (folder / "result.json").write_text(json.dumps(result, indent=2) + "\n")
     return warnings
+
+
+def save_task_png(frames, path: Path, *, title: str = "") -> Path:
+    """The key frames of a task run side by side (grasp, the task's moment, the end), each titled
+    with its name and simulated time."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    if not frames:
+        raise ValueError("no key frames to draw")
+    fig, axes = plt.subplots(1, len(frames), figsize=(4.2 * len(frames), 3.6), squeeze=False)
+    for ax, (name, t, rgb) in zip(axes[0], frames, strict=True):
+        ax.imshow(rgb)
+        ax.set_title(f"{name}, t = {t:.1f} s", fontsize=10)
+        ax.axis("off")
+    if title:
+        fig.suptitle(textwrap.shorten(title, 60 * len(frames)), fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def _task_title(result: dict) -> str:
+    """task.png's title: the task and its outcome in physics, with its measure."""
+    t = result.get("task_outcome") or {}
+    if not t:
+        return f"task {result.get('task_given')}: no task check ({result['outcome']['status']})"
+    measure = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}"
+                        for k, v in (t.get("measure") or {}).items())
+    return (f"{t['task']}: {'success' if t['success'] else 'failed'}"
+            + (f" ({measure})" if measure else "") + (f" — {t['detail']}" if t.get("detail")
+                                                      else ""))
 
 
 def _save_rgb(rgb: np.ndarray, path: Path) -> None:

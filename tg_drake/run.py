@@ -21,6 +21,7 @@ outcome with status "failed" and its reason.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from pathlib import Path
 
@@ -70,6 +71,7 @@ def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
     from pydrake.systems.framework import DiagramBuilder, EventStatus
 
     from tg_drake.diagram import add_pipeline
+    from tg_drake.render import PositionRecorder, key_times, render_key_frames
     from tg_drake.report import Pictures, Stages, evaluate_stages, final_stages, result_of
     from tg_drake.systems.supervisor import Outcome, Reason, Status, outcome_of_error
 
@@ -102,8 +104,16 @@ def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
     def outcome_now(root_context) -> Outcome:
         return outcome_port.Eval(supervisor.GetMyContextFromRoot(root_context))
 
-    simulator.set_monitor(lambda root: EventStatus.ReachedTermination(supervisor, "outcome final")
-                          if outcome_now(root).final else EventStatus.DidNothing())
+    # With pictures, the plant's positions are kept for the task's key frames (task.png).
+    recorder = PositionRecorder(pipeline.station.plant) if images else None
+
+    def monitor(root):
+        if recorder is not None:
+            recorder.record(root)
+        return (EventStatus.ReachedTermination(supervisor, "outcome final")
+                if outcome_now(root).final else EventStatus.DidNothing())
+
+    simulator.set_monitor(monitor)
 
     if visualizer is not None:
         visualizer.StartRecording()
@@ -139,7 +149,15 @@ def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
     timings["total"] = time.perf_counter() - t_start
     result = result_of(scenario=scenario, scenario_path=scenario_path, stages=stages,
                        outcome=outcome, plan_status=plan_status, timings=timings)
-    return result, Pictures(stages, X_WG=plan_status.X_WG)
+    pictures = Pictures(stages, X_WG=plan_status.X_WG)
+    if recorder is not None and recorder.times and scenario.task.task and \
+            plan_status.plan is not None and plan_status.t_plan is not None:
+        keys = key_times(plan_status.plan, plan_status.t_plan, context.get_time(),
+                         scenario.task.task)
+        camera = getattr(scenario.pipeline.perception, "camera", next(iter(scenario.cameras), ""))
+        pictures.task_frames = functools.partial(render_key_frames, scenario, recorder, keys,
+                                                 camera)
+    return result, pictures
 
 
 def _in_file(error: TgDrakeError, scenario_path: str) -> TgDrakeError:

@@ -261,10 +261,21 @@ class OnePart:
     model: str = ""  # as DgiScorer.model
 
 
-ScoringVariant = DgiScorer | LocalOnly | OnePart
+@dataclass
+class RandomPart:
+    """The random-part baseline: one part drawn uniformly among the parts that have a pre-grasp
+    hypothesis (with `seed`, so a run repeats), its hypotheses ranked by P(grasp | local shape);
+    every other hypothesis scores 0."""
+
+    seed: int = 0  # seeds the draw (the evaluation sets it from the case)
+    model: str = ""  # as DgiScorer.model
+
+
+ScoringVariant = DgiScorer | LocalOnly | OnePart | RandomPart
 
 # The core's name (tg_drake.grasping.scoring.SELECTIONS) of each scoring variant.
-SELECTION_OF_SCORING = {DgiScorer: "pipeline", LocalOnly: "local_only", OnePart: "one_part"}
+SELECTION_OF_SCORING = {DgiScorer: "pipeline", LocalOnly: "local_only", OnePart: "one_part",
+                        RandomPart: "random_part"}
 
 
 @dataclass

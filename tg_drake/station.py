@@ -52,6 +52,7 @@ from pydrake.geometry import (
     PerceptionProperties,
     ProximityProperties,
     RenderEngineGlParams,
+    Rgba,
     SceneGraph,
     Sphere,
     kHasRenderEngineGl,
@@ -181,7 +182,8 @@ def _apply_joint_pd(plant: MultibodyPlant, instance: ModelInstanceIndex, kp: flo
 
 
 def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser,
-                 contents: list[ContentsModel]) -> dict[str, ModelInstanceIndex]:
+                 contents: list[ContentsModel], visible: bool = False
+                 ) -> dict[str, ModelInstanceIndex]:
     if not scenario.objects:
         return {}
     # User libraries and mesh entries (a validated scenario's paths are absolute; the import is
@@ -199,7 +201,7 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser,
         if placement.containment == "full" and scenario.contents.model == "spheres":
             contents.append(_add_sphere_contents(plant, placement, get_object(placement.id),
                                                  placement_pose(scenario, placement),
-                                                 scenario.contents))
+                                                 scenario.contents, visible))
         elif placement.containment == "full":
             _add_contents(plant, instance, body, get_object(placement.id))
     return objects
@@ -242,7 +244,7 @@ def _illustration_only(shape, name: str, X_BG: RigidTransform, rgba, visible: bo
     instance.set_illustration_properties(MakePhongIllustrationProperties(np.asarray(rgba)))
     if visible:
         perception = PerceptionProperties()
-        perception.AddProperty("phong", "diffuse", np.asarray(rgba))
+        perception.AddProperty("phong", "diffuse", Rgba(*rgba))
         instance.set_perception_properties(perception)
     return instance
 
@@ -280,7 +282,8 @@ def exclude_mutual_contact(plant: MultibodyPlant, scene_graph: SceneGraph,
 
 
 def _add_sphere_contents(plant: MultibodyPlant, placement: ObjectPlacement, obj,
-                         X_WO: RigidTransform, config: ContentsConfig) -> ContentsModel:
+                         X_WO: RigidTransform, config: ContentsConfig,
+                         visible: bool = False) -> ContentsModel:
     """A "full" container's water as free spheres packed in its cavity, of the water's total
     mass (WATER_DENSITY × cavity volume), in a model instance `<name>_contents`."""
     V, F = mesh(obj)[:2]
@@ -289,7 +292,8 @@ def _add_sphere_contents(plant: MultibodyPlant, placement: ObjectPlacement, obj,
     instance = plant.AddModelInstance(f"{name}_contents")
     mass = WATER_DENSITY * obj.cavity_volume / len(p_O)
     p_W = p_O @ X_WO.rotation().matrix().T + X_WO.translation()
-    bodies = add_spheres(plant, instance, f"{name}_sphere", p_W, config.radius, mass, config)
+    bodies = add_spheres(plant, instance, f"{name}_sphere", p_W, config.radius, mass, config,
+                         visible)
     return ContentsModel(name=name, bodies=bodies, radius=config.radius)
 
 
@@ -299,7 +303,8 @@ def dispenser_frame(scenario: Scenario) -> RigidTransform:
     return scenario.X_WT.GetDeterministicValue() @ RigidTransform([d.xy[0], d.xy[1], d.height])
 
 
-def _add_dispenser(plant: MultibodyPlant, scenario: Scenario) -> tuple[ContentsModel, object]:
+def _add_dispenser(plant: MultibodyPlant, scenario: Scenario, visible: bool = False
+                   ) -> tuple[ContentsModel, object]:
     """The dispenser: a square hopper welded above the table, its spheres, and a gate under it on
     a PD-driven slide along the table's x (closed at 0, open at one width and a wall). Returns the
     spheres and the gate joint."""
@@ -322,13 +327,13 @@ def _add_dispenser(plant: MultibodyPlant, scenario: Scenario) -> tuple[ContentsM
         X = RigidTransform([x, y, z])
         plant.RegisterCollisionGeometry(hopper, X, Box(sx, sy, h), f"wall_{k}", rigid)
         plant.RegisterVisualGeometry(hopper, _illustration_only(
-            Box(sx, sy, h), f"wall_{k}_visual", X, DISPENSER_COLOR, False))
+            Box(sx, sy, h), f"wall_{k}_visual", X, DISPENSER_COLOR, visible))
     gate = plant.AddRigidBody("dispenser_gate", instance, SpatialInertia.SolidBoxWithMass(
         GATE_MASS, w + 2 * t, w + 2 * t, t))
     X = RigidTransform([0, 0, -t / 2])
     plant.RegisterCollisionGeometry(gate, X, Box(w + 2 * t, w + 2 * t, t), "gate", rigid)
     plant.RegisterVisualGeometry(gate, _illustration_only(
-        Box(w + 2 * t, w + 2 * t, t), "gate_visual", X, DISPENSER_COLOR, False))
+        Box(w + 2 * t, w + 2 * t, t), "gate_visual", X, DISPENSER_COLOR, visible))
     joint = plant.AddJoint(PrismaticJoint("dispenser_gate_slide", hopper.body_frame(),
                                           gate.body_frame(), [1.0, 0.0, 0.0]))
     actuator = plant.AddJointActuator("dispenser_gate_actuator", joint, GATE_FORCE)
@@ -338,7 +343,7 @@ def _add_dispenser(plant: MultibodyPlant, scenario: Scenario) -> tuple[ContentsM
     p_W = p_H @ X_WH.rotation().matrix().T + X_WH.translation()
     mass = WATER_DENSITY * 4.0 / 3.0 * np.pi * radius**3
     bodies = add_spheres(plant, spheres, "dispenser_sphere", p_W, radius, mass,
-                         scenario.contents)
+                         scenario.contents, visible)
     return ContentsModel(name="dispenser", bodies=bodies, radius=radius), joint
 
 
@@ -362,8 +367,11 @@ class DispenserCommand(LeafSystem):
         output.SetFromVector([self._travel if is_open else 0.0, 0.0])
 
 
-def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
-    """Adds the plant, scene graph, drivers and cameras of `scenario` to `builder`."""
+def add_station(builder: DiagramBuilder, *, scenario: Scenario,
+                contents_visible: bool = False) -> Station:
+    """Adds the plant, scene graph, drivers and cameras of `scenario` to `builder`. The cameras
+    see the contents' spheres and the dispenser only with `contents_visible` (the pictures'
+    station, tg_drake.render; never perception's)."""
     _check_renderers(scenario)
     # Plant and scene graph, hydroelastic contact with SAP.
     plant, scene_graph = AddMultibodyPlant(scenario.plant_config, builder)
@@ -384,10 +392,10 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario) -> Station:
     instances["table"] = add_table(plant, scenario.table_size, X_WT)
     add_surfaces(plant, instances["table"], scenario.surfaces)
     contents: list[ContentsModel] = []
-    objects = _add_objects(scenario, plant, parser, contents)
+    objects = _add_objects(scenario, plant, parser, contents, contents_visible)
     instances.update(objects)
     if scenario.dispenser is not None:
-        dispensed, _ = _add_dispenser(plant, scenario)
+        dispensed, _ = _add_dispenser(plant, scenario, contents_visible)
         contents.append(dispensed)
 
     # Drivers: PD control on the joint actuators (desired state enters the plant).
@@ -540,10 +548,11 @@ def _add_inverse_dynamics(builder, scenario, plant, iiwa, driver):
     return controller
 
 
-def make_station(scenario: Scenario) -> tuple[Diagram, Station]:
+def make_station(scenario: Scenario, *, contents_visible: bool = False
+                 ) -> tuple[Diagram, Station]:
     """A standalone station diagram with every station port exported under its name."""
     builder = DiagramBuilder()
-    station = add_station(builder, scenario=scenario)
+    station = add_station(builder, scenario=scenario, contents_visible=contents_visible)
     for name, port in station.inputs.items():
         builder.ExportInput(port, name)
     for name, port in station.outputs.items():

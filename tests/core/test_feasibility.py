@@ -165,3 +165,26 @@ def test_a_colliding_pose_gets_no_hold():
     assert f.reasons[0].startswith("collision")
 
 
+def test_the_assessed_candidates_keep_the_scorers_score(monkeypatch):
+    """Local and one-part scoring rank otherwise than P(part | task) · P(grasp | local shape);
+    the stage multiplies their score by nothing but P(hold) (off by default) or 0."""
+    from types import SimpleNamespace
+
+    from tg_drake.grasping import feasibility
+    from tg_drake.types import GraspCandidates, ObjectDescription, SceneDescription
+
+    monkeypatch.setattr(feasibility, "grasp_feasibility", lambda X_WG, **kw: SimpleNamespace(
+        reasons=["", "", "in collision with the table", ""], p_hold=np.full(len(X_WG), 0.5)))
+    obj = ObjectDescription(
+        p_W=np.zeros((10, 3)), n_W=np.zeros((10, 3)), labels=np.zeros(10, int),
+        visible=np.ones(10, bool), X_WO=np.eye(4), extents=np.full(3, 0.1), pose="upright",
+        pose_likelihood={"upright": 1.0}, part_probabilities={}, part_boxes={},
+        pregrasp_X_WG=np.tile(np.eye(4), (4, 1, 1)), pregrasp_parts=np.array([1, 3, 1, 0]))
+    local = np.array([0.9, 0.8, 0.7, 0.5])  # ranked by P(grasp | local shape) alone
+    candidates = GraspCandidates(np.tile(np.eye(4), (4, 1, 1)), np.array([0, 3, 1, 1]),
+                                 np.array([0.1, 0.0, 0.9, 0.9]), local, local.copy())
+    out = feasibility.assess_candidates(SceneDescription(objects=[obj], X_WT=np.eye(4)),
+                                        candidates, category=None, approach=0.1,
+                                        config=FeasibilityConfig())
+    assert np.allclose(out.score, [0.9, 0.8, 0.5, 0.0])  # the third is infeasible: 0, last
+    assert out.source.tolist() == [0, 1, 3, 2]

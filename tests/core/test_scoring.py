@@ -75,3 +75,22 @@ def test_an_executed_pose_is_matched_to_the_scored_pose_it_is():
     # execute): not a pose the DGI scored.
     other = scored_pose_match(tilted(ranked.X_WG[0], np.deg2rad(10.0)), ranked)
     assert not other["same"] and np.degrees(other["angle_rad"]) == pytest.approx(10.0)
+
+
+def test_random_part_draws_one_part_among_the_hypotheses_and_ranks_it_by_local_shape():
+    from tg_drake.grasping.scoring import random_part
+
+    drawn = [random_part(PARTS, seed) for seed in range(300)]
+    counts = {p: drawn.count(p) for p in set(drawn)}
+    assert set(counts) == {"middle", "handle", "top"}  # the parts with a hypothesis, no other
+    assert min(counts.values()) > 60  # uniform over the 3 parts (100 each expected), not by count
+    assert [random_part(PARTS, 7) for _ in range(3)] == [random_part(PARTS, 7)] * 3  # repeats
+    for seed in (0, 1, 2, 5):
+        ranked = rank_grasps(scene(), SEMANTICS, FixedModel(), selection="random_part",
+                             seed=seed)
+        chosen = PART_LABELS.index(random_part(PARTS, seed))
+        expected = np.sort(np.where(PARTS == chosen, P_LOCAL, 0.0))[::-1]
+        assert np.allclose(ranked.score, expected)  # the logic's handle = 0 does not matter
+        assert set(ranked.parts[ranked.score > 0].tolist()) == {chosen}
+    with pytest.raises(GraspingError, match="no pre-grasp hypothesis"):
+        random_part(np.zeros(0, int), 0)

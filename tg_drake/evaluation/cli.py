@@ -6,8 +6,9 @@
 Writes, in DIR: `results.jsonl` (one line per case as it finishes — perceived cases one per
 setting; a rerun skips finished cases; a crashed case is recorded as an error and counts as a
 failure), then `tables.json`, `tables.md` and PNG plots derived from every record of the suites
-given (`--name logic`: logic.json, logic.md, logic_*.png). `--tables-only` derives the tables
-from the records already there.
+given (`--name logic`: logic.json, logic.md, logic_*.png), and prints the task success per task
+and variant when the task suites are among them. `--tables-only` derives the tables from the
+records already there.
 
 `--shard I/N` runs the I-th of N deterministic slices of the cases into `results-I-of-N.jsonl`
 (tg_drake.evaluation.shards); the tables are always derived from every results file in DIR (and
@@ -220,6 +221,10 @@ def main(args) -> int:
                                    merged.report().splitlines())
     tables = write_tables(folder, records, command,
                           notes=suite_notes(args.suites) + "\n\n" + coverage, name=args.name)
+    from tg_drake.evaluation.tables import task_success_text  # start-up (pydrake)
+
+    if text := task_success_text(tables):
+        print(text)
     print(f"{len(done)} of {len(cases)} cases have records; tables in {folder}/{args.name}.md "
           f"({tables['n_errors']} crashed cases counted as failures)")
     return 0

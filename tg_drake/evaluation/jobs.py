@@ -11,7 +11,8 @@ table can be derived again from the records (tg_drake.evaluation.tables).
   task (inferred) and, for each ground-truth task given, the pre-grasp part.
 - perceived: the object's depth image ray cast from the default camera's viewpoint and perceived;
   pose and part detection against the truth; then the same queries on observations of each setting.
-- executed: `tg_drake.run.run_scenario` on the scenario in the case's variant; `build_s` is the
+- executed: `tg_drake.run.run_scenario` on the scenario in the case's variant (`scoring_of`) and
+  the suite's task scene; `build_s` is the
   wall time of building its diagram and context [s] (the executor adds `worker_pid` and `rss_mb`).
 """
 
@@ -39,8 +40,8 @@ from tg_drake.scenario import (
     DgiScorer,
     LocalOnly,
     PipelineConfig,
+    RandomPart,
     Scenario,
-    TaskConfig,
     resolve_objects,
     validate,
 )
@@ -199,16 +200,26 @@ def run_perceived(case) -> list[dict]:
     return records
 
 
+def scoring_of(case):
+    """The scoring stage of an executed case's variant: the DGI (pipeline, pipeline_uniform),
+    P(grasp | local shape) alone (local), or a part drawn at random, seeded by the case's scenario
+    (its key without the variant) and the suite's seed, so that it repeats (random_part)."""
+    if case.variant == "local":
+        return LocalOnly()
+    if case.variant == "random_part":
+        return RandomPart(seed=_seed(case.key.split("@")[0], case.seed) % 2**31)
+    return DgiScorer()
+
+
 def scenario_of(case) -> Scenario:
-    """The scenario an executed case runs (validated)."""
+    """The scenario an executed case runs (validated): its scene (and the suite's task scene)
+    with the variant's pipeline."""
     pipeline = PipelineConfig(perception=DepthPerception(sensor=EVALUATION_SENSOR),
-                              scoring=LocalOnly() if case.variant == "local" else DgiScorer())
+                              scoring=scoring_of(case))
     pipeline.logic.category = pipeline.logic.grasp = case.theory
     pipeline.logic.use_prior = case.variant != "pipeline_uniform"
-    scenario = Scenario(objects=list(case.objects), pipeline=pipeline,
-                        task=TaskConfig(target=case.target, task=case.task,
-                                        place_xy=list(case.place_xy)),
-                        object_libraries=list(case.object_libraries))
+    scenario = case.scenario()
+    scenario.pipeline = pipeline
     validate(scenario, where=case.key)
     return scenario
 

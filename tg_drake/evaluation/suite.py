@@ -11,8 +11,15 @@ A suite is of one kind:
   kept; S_REAL_noisy: perceived pose likelihood and part likelihoods).
 - "executed": scenarios run end to end in simulation (`tg_drake.run.run_scenario`), in variants
   "pipeline" (kernel prior + logic + DGI), "pipeline_uniform" (uniform category prior) and "local"
-  (hypotheses ranked by the DGI's P(grasp | local shape) alone): S_GRASP and S_ROBOT, and the
-  single-object sweep (dataset "sweep", ours).
+  (hypotheses ranked by the DGI's P(grasp | local shape) alone) and "random_part" (a part drawn
+  uniformly, seeded by the case, among those with a pre-grasp hypothesis; its grasp by P(grasp |
+  local shape)): S_GRASP and S_ROBOT, the single-object sweep (dataset "sweep", ours) and the task
+  suites (dataset "tasks", ours: each task executed and judged by physics).
+
+An executed suite's `task_scene` is what the task needs in every case's scene beside the target
+(`TaskScene`: a bowl to pour into, surfaces, the contents' model, a dispenser, the run's duration);
+each case's scenario is validated when the suite loads. Every record says which side of the
+object-wise split (tg_drake.evaluation.split) its target is on (`split`: train / held_out).
 
 Cases come from a `generator` (objects × poses × containments × yaws × tasks, or `sample` cases
 drawn from that product with the suite's seed, moved and turned at random) or from `scenes`
@@ -24,6 +31,7 @@ naming the file, the field and the allowed values.
 """
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,10 +41,14 @@ import yaml
 from pydrake.common.yaml import yaml_load_typed
 
 from tg_drake.errors import ScenarioError, unknown_name
+from tg_drake.evaluation.split import load_split
 from tg_drake.objects import get_object, load_library
 from tg_drake.scenario import (
+    ContentsConfig,
+    DispenserConfig,
     ObjectPlacement,
     Scenario,
+    SurfaceConfig,
     TaskConfig,
     add_object_libraries,
     validate,
@@ -45,12 +57,12 @@ from tg_drake.types import CATEGORIES, CONTAINMENTS, PART_LABELS, POSES, TASKS
 
 KINDS = ("synthetic", "perceived", "executed")
 SETTINGS = ("semi", "real", "noisy")  # perceived suites: the paper's S_REAL_semi / S_REAL / noisy
-VARIANTS = ("pipeline", "pipeline_uniform", "local")  # executed suites
+VARIANTS = ("pipeline", "pipeline_uniform", "local", "random_part")  # executed suites
 # dataset label → the paper's name (rows of the section VI tables).
 DATASETS = {"syn": "S_SYN", "real_semi": "S_REAL_semi", "real": "S_REAL",
             "real_noisy": "S_REAL_noisy", "grasp": "S_GRASP_noisy", "robot": "S_ROBOT",
-            "sweep": "Sweep"}
-OURS = ("sweep",)  # datasets of ours, not analogues of the paper's (no paper figures)
+            "sweep": "Sweep", "tasks": "Tasks"}
+OURS = ("sweep", "tasks")  # datasets of ours, not analogues of the paper's (no paper figures)
 DATASET_OF_SETTING = {"semi": "real_semi", "real": "real", "noisy": "real_noisy"}
 CLASSES = ("dish", "kitchen_container", "canister", "tool")  # rules/README.md tables 1 and 5
 
@@ -125,6 +137,36 @@ class Scene:
 
 
 @dataclass
+class TaskScene:
+    """What a task needs in the scene of every case of an executed suite, beside the target (the
+    scenario's fields of the same names; tg_drake.scenario)."""
+
+    objects: list[ObjectPlacement] = field(default_factory=list)  # more objects, e.g. the bowl
+    # pourOut pours into; their instance names must differ from the targets'
+    surfaces: list[SurfaceConfig] = field(default_factory=list)  # p&pOn: boxes on the table
+    place_on: str = ""  # p&pOn: task.place_on (the surface's name)
+    pour_into: str = ""  # pourOut: task.pour_into (the instance name of one of `objects`)
+    contents: ContentsConfig | None = None  # None: the scenario's default (the mass model)
+    dispenser: DispenserConfig | None = None  # pourIn: the dispenser of spheres
+    simulation_duration: float = 0.0  # [s] upper bound of a run; 0: the scenario's default
+
+    def apply(self, scenario: Scenario) -> Scenario:
+        """`scenario` with this task scene added (in place; returned)."""
+        scenario.objects = list(scenario.objects) + [dataclasses.replace(p)
+                                                     for p in self.objects]
+        scenario.surfaces = [dataclasses.replace(s) for s in self.surfaces]
+        scenario.task.place_on = self.place_on
+        scenario.task.pour_into = self.pour_into
+        if self.contents is not None:
+            scenario.contents = dataclasses.replace(self.contents)
+        if self.dispenser is not None:
+            scenario.dispenser = dataclasses.replace(self.dispenser)
+        if self.simulation_duration:
+            scenario.simulation_duration = self.simulation_duration
+        return scenario
+
+
+@dataclass
 class Suite:
     name: str = ""
     description: str = ""
@@ -140,6 +182,7 @@ class Suite:
     seed: int = 0  # seeds the kernel prior's samplings
     object_libraries: list[str] = field(default_factory=list)  # user object library folders
     # (relative to the suite file) whose objects the generator and the scenes may name
+    task_scene: TaskScene | None = None  # executed: what every case's scene adds for its task
 
 
 @dataclass(frozen=True)
@@ -169,22 +212,47 @@ class Case:
     seed: int = 0
     theory: str = "specific"  # the model variant standing in for "specific" (PLM, pipeline)
     object_libraries: tuple[str, ...] = ()  # absolute folders of the user libraries it names
+    task_scene: TaskScene | None = None  # executed: what the scene adds for the task
 
     @property
     def target_placement(self) -> ObjectPlacement:
         return next(p for p in self.objects if p.instance_name == self.target)
 
+    def scenario(self) -> Scenario:
+        """The case's scene as a scenario (the default pipeline; not validated): its objects, its
+        task and the suite's task scene."""
+        scenario = Scenario(objects=[dataclasses.replace(p) for p in self.objects],
+                            task=TaskConfig(target=self.target, task=self.task,
+                                            place_xy=list(self.place_xy)),
+                            object_libraries=list(self.object_libraries))
+        return self.task_scene.apply(scenario) if self.task_scene is not None else scenario
+
     def meta(self) -> dict:
         """The case as JSON (part of every record it gives)."""
         p = self.target_placement
         return {"suite": self.suite, "kind": self.kind, "dataset": self.dataset,
-                "variant": self.variant, "object": p.id, "pose": p.pose, "yaw": p.yaw,
+                "variant": self.variant, "object": p.id, "split": split_role(p.id),
+                "pose": p.pose, "yaw": p.yaw,
                 "containment": p.containment, "object_parts": list(get_object(p.id).parts),
                 "n_objects": len(self.objects),
                 "task_given": self.task, "theory": self.theory, "truth": {
                     "category": self.truth.category, "tasks": list(self.truth.tasks),
                     "parts": {t: list(v) for t, v in self.truth.parts.items()},
                     "reason": self.truth.reason}}
+
+
+@functools.cache
+def _split():
+    return load_split()
+
+
+def split_role(obj_id: str) -> str | None:
+    """"train" or "held_out": the object's side of the object-wise split
+    (scenarios/suites/split.yaml); None for an object in none of its sets (a user's)."""
+    try:
+        return _split().role(obj_id)
+    except ScenarioError:
+        return None
 
 
 def _load_typed(cls, path: Path):
@@ -359,7 +427,8 @@ def _generated(suite: Suite, gt: GroundTruthTables, where: str, gt_where: str) -
                                 key, suite.name, suite.kind, suite.dataset, (placement,),
                                 placement.instance_name, task, tuple(g.place_xy), truth,
                                 variant, tuple(suite.settings), suite.kernel_T, suite.seed,
-                                object_libraries=tuple(suite.object_libraries)))
+                                object_libraries=tuple(suite.object_libraries),
+                                task_scene=suite.task_scene))
     return _drawn(suite, cases, library) if g.sample else cases
 
 
@@ -437,8 +506,35 @@ def _scenes(suite: Suite, where: str) -> list[Case]:
                 cases.append(Case(key, suite.name, suite.kind, suite.dataset, tuple(objects),
                                   target.instance_name, task.task, tuple(task.place_xy), truth,
                                   variant, tuple(suite.settings), suite.kernel_T, suite.seed,
-                                  object_libraries=tuple(suite.object_libraries)))
+                                  object_libraries=tuple(suite.object_libraries),
+                                task_scene=suite.task_scene))
     return cases
+
+
+def _check_task_scenes(suite: Suite, cases: list[Case], where: str) -> None:
+    """Every case's scene with the suite's task scene validated (once per scenario, whatever its
+    variant): a surface under the target, a bowl where the target stands, a container whose
+    cavity cannot hold the spheres is named with the case."""
+    if suite.kind != "executed":
+        raise ScenarioError("a task scene is for executed suites", file=where,
+                            field="task_scene")
+    if suite.task_scene.simulation_duration < 0 or not math.isfinite(
+            suite.task_scene.simulation_duration):
+        raise ScenarioError(f"simulation_duration must be ≥ 0 and finite [s] (0: the "
+                            f"scenario's default), got {suite.task_scene.simulation_duration}",
+                            file=where, field="task_scene.simulation_duration")
+    seen = set()
+    for case in cases:
+        name = case.key.split("@")[0]
+        if name in seen:
+            continue
+        seen.add(name)
+        try:
+            validate(case.scenario(), where=where, base_dir=Path(where).parent)
+        except ScenarioError as e:
+            raise ScenarioError(f"case {name}: {e.message}", file=where,
+                                field=f"task_scene ({e.field})" if e.field else "task_scene"
+                                ) from None
 
 
 def load_suite(path: "str | Path") -> "tuple[Suite, list[Case]]":
@@ -488,6 +584,8 @@ def load_suite(path: "str | Path") -> "tuple[Suite, list[Case]]":
         cases = _scenes(suite, where)
     if not cases:
         raise ScenarioError("the suite has no cases (every object filtered out?)", file=where)
+    if suite.task_scene is not None:
+        _check_task_scenes(suite, cases, where)
     keys = [c.key for c in cases]
     if len(set(keys)) != len(keys):
         dup = sorted({k for k in keys if keys.count(k) > 1})

@@ -441,10 +441,11 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
                       config: FeasibilityConfig, model: HoldModel | None = None
                       ) -> GraspCandidates:
     """The candidates (the poses that may be executed: the scoring stage made and scored them,
-    `tg_drake.grasping.expansion`), each with P(hold) and the score P(part | task) · P(grasp |
-    local shape) · P(hold) (0 with a reason where infeasible), best first; the poses are not
-    changed. `category`: the logic's category distribution (the mass's density prior);
-    `approach` [m]: the planner's pre-grasp distance (the approach swept for collisions)."""
+    `tg_drake.grasping.expansion`), each with P(hold) and the scorer's score (the pipeline's
+    P(part | task) · P(grasp | local shape); the Local, one-part and random-part variants score
+    otherwise) · P(hold) when `rank_by_hold` (0 with a reason where infeasible), best first; the
+    poses are not changed. `category`: the logic's category distribution (the mass's density
+    prior); `approach` [m]: the planner's pre-grasp distance (the approach swept for collisions)."""
     m = len(candidates.score)
     if m == 0 or not 0 <= candidates.target < len(scene.objects):
         return GraspCandidates(np.zeros((0, 4, 4)), np.zeros(0, int), np.zeros(0), np.zeros(0),
@@ -463,10 +464,13 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
     p_local = np.asarray(candidates.p_local, float)
     parts = np.asarray(candidates.parts, int)
     ok = np.array([not r for r in f.reasons], bool)
-    score = np.where(ok, p_part * p_local * (f.p_hold if config.rank_by_hold else 1.0), 0.0)
+    # The scorer's score (P(part | task) · P(grasp | local shape) for the pipeline; the Local,
+    # one-part and random-part variants score otherwise), pose by pose.
+    scored = np.asarray(candidates.score, float)
+    score = np.where(ok, scored * (f.p_hold if config.rank_by_hold else 1.0), 0.0)
     order = np.argsort(-score, kind="stable")
-    # Parts the logic and the shape allow, none of whose poses would hold (not for collisions).
-    viable = p_part * p_local > 0
+    # Parts the scorer allows, none of whose poses would hold (not for collisions).
+    viable = scored > 0
     unholdable = tuple(
         PART_LABELS[k] for k in np.unique(parts[viable])
         if not ok[viable & (parts == k)].any()

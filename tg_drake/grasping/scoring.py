@@ -8,6 +8,8 @@ feasibility stage and the planner take these poses as they are.
 `selection="local_only"` ranks by P(grasp | local shape) alone, ignoring the logic: the paper's
 Local baseline (section VI, Table "pipeline"). `selection="one_part"` scores only the hypotheses of
 one part, by P(grasp | local shape) alone (for collecting grasp outcomes per part).
+`selection="random_part"` is the random-part baseline: one part drawn uniformly (seeded) among the
+parts that have a hypothesis, its hypotheses ranked by P(grasp | local shape), the others 0.
 """
 
 from __future__ import annotations
@@ -19,7 +21,8 @@ from tg_drake.grasping.expansion import ExpansionConfig, executed_poses
 from tg_drake.grasping.model import DgiGraspModel
 from tg_drake.types import PART_LABELS, GraspCandidates, GraspSemantics, SceneDescription
 
-SELECTIONS = ("pipeline", "local_only", "one_part")  # how rank_grasps scores a hypothesis
+# How rank_grasps scores a hypothesis.
+SELECTIONS = ("pipeline", "local_only", "one_part", "random_part")
 
 
 def check_selection(selection: str, part: str | None = None) -> None:
@@ -38,7 +41,7 @@ def rank_grasps(scene: SceneDescription, semantics: GraspSemantics,
                 model: DgiGraspModel | None, *, selection: str = "pipeline",
                 part: str | None = None, p_local: np.ndarray | None = None,
                 expansion: ExpansionConfig = DEFAULT_EXPANSION,
-                approach: float = DEFAULT_APPROACH) -> GraspCandidates:
+                approach: float = DEFAULT_APPROACH, seed: int = 0) -> GraspCandidates:
     """Every pose that may be executed for the target object's pre-grasp hypotheses
     (`candidate_poses`), scored and sorted best first; `source` names each pose's hypothesis.
 
@@ -48,7 +51,8 @@ def rank_grasps(scene: SceneDescription, semantics: GraspSemantics,
     P(part | task) of the hypothesis' part (0 for a part the logic did not name), score =
     p_part · p_local (`selection="pipeline"`) or p_local alone (`"local_only"`), or p_local for
     the hypotheses of `part` and 0 for the others (`"one_part"`: a part the logic gives 0 is
-    still ranked). Ties keep the hypotheses' order.
+    still ranked), or p_local for the hypotheses of the part `random_part(parts, seed)` draws
+    and 0 for the others (`"random_part"`). Ties keep the hypotheses' order.
     """
     check_selection(selection, part)
     target = semantics.target
@@ -68,11 +72,23 @@ def rank_grasps(scene: SceneDescription, semantics: GraspSemantics,
         score = p_part * p_local
     elif selection == "local_only":
         score = p_local
-    else:
+    elif selection == "one_part":
         score = np.where(parts == PART_LABELS.index(part), p_local, 0.0)
+    else:
+        score = np.where(parts == PART_LABELS.index(random_part(parts, seed)), p_local, 0.0)
     order = np.argsort(-score, kind="stable")
     return GraspCandidates(X_WG[order], parts[order], p_part[order], p_local[order], score[order],
                            target, source=source[order])
+
+
+def random_part(parts: np.ndarray, seed: int) -> str:
+    """The random-part baseline's part: drawn uniformly among the distinct parts of the
+    hypotheses (indices into PART_LABELS), by a generator seeded with `seed` alone, so that the
+    same hypotheses and seed give the same part (a re-ranking after a re-query too)."""
+    present = np.unique(np.asarray(parts, dtype=int))
+    if present.size == 0:
+        raise GraspingError("random_part: the object has no pre-grasp hypothesis to draw from")
+    return PART_LABELS[int(present[np.random.default_rng(seed).integers(present.size)])]
 
 
 def candidate_poses(scene: SceneDescription, target: int, *,

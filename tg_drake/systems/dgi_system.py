@@ -45,18 +45,20 @@ class DgiScoringSystem(LeafSystem):
 
     The model is the one shipped with the package unless `model` is given. `selection`
     "local_only" ranks by P(grasp | local shape) alone (the paper's Local baseline); "one_part"
-    ranks only the hypotheses of `part`, by P(grasp | local shape) (`rank_grasps`).
+    ranks only the hypotheses of `part`, by P(grasp | local shape) (`rank_grasps`); "random_part"
+    those of a part drawn with `seed`.
     """
 
     def __init__(self, model: DgiGraspModel | None = None, *, selection: str = "pipeline",
                  part: str | None = None, expansion: ExpansionConfig | None = None,
-                 approach: float = DEFAULT_APPROACH):
+                 approach: float = DEFAULT_APPROACH, seed: int = 0):
         super().__init__()
         check_selection(selection, part)
         self._expansion = expansion or ExpansionConfig()
         self._approach = float(approach)
         self._selection = selection
         self._part = part
+        self._seed = seed
         self._model = model if model is not None else load_default_model()
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description",
@@ -114,4 +116,4 @@ class DgiScoringSystem(LeafSystem):
         output.set_value(rank_grasps(self._scene_port.Eval(context), semantics, self._model,
                                      selection=self._selection, part=self._part,
                                      p_local=p_local, expansion=self._expansion,
-                                     approach=self._approach))
+                                     approach=self._approach, seed=self._seed))
