@@ -112,14 +112,16 @@ def _read(path: Path) -> list[dict]:
         return [json.loads(line) for line in f if line.strip()]
 
 
-def compare(a: list[dict], b: list[dict]) -> list[str]:
-    """Keys (job, setting) whose records differ, or that one side lacks."""
+def compare(a: list[dict], b: list[dict]) -> tuple[list[str], int]:
+    """The records (job, setting) both files hold that differ, and how many both hold (a subset
+    run, `--stride`, is compared with the cases it shares with a whole run)."""
     def keyed(rs):
         return {(r["job"], r.get("setting")): {k: v for k, v in r.items()
                                                if k not in ("wall_s", "worker_pid", "rss_mb")}
                 for r in rs}
     ka, kb = keyed(a), keyed(b)
-    return sorted(f"{j} [{s}]" for j, s in set(ka) | set(kb) if ka.get((j, s)) != kb.get((j, s)))
+    common = set(ka) & set(kb)
+    return sorted(f"{j} [{s}]" for j, s in common if ka[j, s] != kb[j, s]), len(common)
 
 
 def main(argv=None) -> int:
@@ -135,9 +137,10 @@ def main(argv=None) -> int:
                    help="list the cases whose records differ between two records files")
     args = p.parse_args(argv)
     if args.compare:
-        diff = compare(_read(args.compare[0]), _read(args.compare[1]))
-        print(f"{len(diff)} records differ" + "".join(f"\n  {d}" for d in diff[:40]))
-        return 1 if diff else 0
+        diff, n = compare(_read(args.compare[0]), _read(args.compare[1]))
+        print(f"{len(diff)} of the {n} records both hold differ"
+              + "".join(f"\n  {d}" for d in diff[:40]))
+        return 1 if diff or not n else 0
     if args.summary:
         records = _read(args.summary)
     else:
