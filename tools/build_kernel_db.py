@@ -12,8 +12,9 @@ object of the shipped library, as before the split). Two kinds of graphs per obj
 - ground-truth samplings (`--samplings`): uniform on the mesh, random rotation, one point per
   voxel on a shifted grid, the mesh's part labels (the S_SYN analogue);
 - perceived views: the object alone on the table in each of its resting poses, turned by each
-  yaw of `tg_drake.kernels.library.VIEW_YAWS_DEG` (between the evaluation suites' 0, 120, 240), its depth image ray cast from
-  each viewpoint of `VIEWPOINTS`, measured by the evaluation's depth sensor model (the D415,
+  yaw of `tg_drake.kernels.library.VIEW_YAWS_DEG` (between the evaluation suites' 0, 120, 240),
+  its depth image ray cast from each of the first `--viewpoints` of `VIEWPOINTS` (default: the
+  default camera's alone), measured by the evaluation's depth sensor model (the D415,
   `--sensor`; seeded per view by `--seed`) and put through our perception stage
   (`describe_scene`); the perceived cloud with its estimated part labels, resampled like a
   query. A perceived query then meets perceived
@@ -175,6 +176,9 @@ def main(argv=None) -> int:
     parser.add_argument("--sensor", choices=tuple(SENSORS), default="d415",
                         help="depth sensor model of the perceived views (default %(default)s)")
     parser.add_argument("--workers", type=int, default=1, help="processes perceiving views")
+    parser.add_argument("--viewpoints", type=int, default=1, choices=range(1, len(VIEWPOINTS) + 1),
+                        help="the first N of tg_drake.kernels.library.VIEWPOINTS (default "
+                             "%(default)s: the default camera's, the evaluation's)")
     parser.add_argument("--check", action="store_true",
                         help="rebuild in memory and compare with --out instead of writing it")
     args = parser.parse_args(argv)
@@ -188,7 +192,7 @@ def main(argv=None) -> int:
             args.workers, object_ids, (args.objects,))  # registers the split's libraries
     try:
         db, summary = build(samplings=args.samplings, spacing=args.spacing, seed=args.seed,
-                            object_ids=ids, sensor=SENSORS[args.sensor],
+                            object_ids=ids, viewpoints=VIEWPOINTS[:args.viewpoints], sensor=SENSORS[args.sensor],
                             map_fn=map if pool is None else
                             (lambda f, jobs: pool.imap(f, jobs, chunksize=8)))
     finally:

@@ -14,13 +14,19 @@ in order:
    handles at the rim (a cup's handle spans the middle of its side and says nothing).
 3. **Neck.** With no cavity seen, the top is closed. A top much narrower than the base over a
    body as wide as the base at mid-height is a neck: an upright bottle.
-4. **Taper.** A closed top narrower than the base otherwise, narrowing steadily from a rim on the
+4. **Closed end.** With no cavity seen, the end on top is closed: a lid (upright) or the
+   object's own base (upside-down), told by its shape rather than by the outline: a lid is
+   recessed below a rim by a band of depths; a base is flat, or domed up from its centre (a
+   can's bottom). `closed_end` measures the recess and the dome [m]; a logistic model fitted on
+   perceived training views (`ClosedEndModel`, tools/calibrate_pose.py) decides ("lid" or
+   "base"). Without enough points on the top (an open top seen from the side) or without a
+   fitted model, the next cues decide.
+5. **Taper.** A closed top narrower than the base otherwise, narrowing steadily from a rim on the
    table (already at mid-height, or strongly at the top: a can's rolled rim narrows only its last
    centimetre, and only a little), is the shape of a tapered open container (glass, cup, bowl,
    pan) resting on its rim: upside-down.
-5. Otherwise (closed and straight, like a can) the object is taken as upright: standing upright
-   is the usual pose, and an upside-down straight container looks the same from above (the
-   calibrated likelihood of this cue says how often that is wrong).
+6. Otherwise (closed and straight, like a can) the object is taken as upright: standing upright
+   is the usual pose (the calibrated likelihood of this cue says how often that is wrong).
 
 For a horizontal axis without a cavity or a handle at one end, the narrower end is the top (the
 neck of a bottle lying down); equal ends keep the axis direction.
@@ -189,8 +195,8 @@ class PoseEstimate:
     pose: str  # the decision: the axis first (vertical or not), then which end is the top.
     likelihood: dict[str, float]  # POSES entry → probability (sums to 1).
     top_sign: float  # +1 when the object's top is at the positive end of the axis, else −1.
-    cue: str  # the cue that placed the top: "cavity", "handle", "neck", "taper", "straight",
-    # or "ends".
+    cue: str  # the cue that placed the top: "cavity", "handle", "neck", "lid", "base",
+    # "taper", "straight", or "ends".
     inward_points: int = 0  # visible body points whose normal points into the object ...
     inward_share: float = 0.0  # ... and their share of the visible body points.
     end: ClosedEnd | None = None  # the closed end on top, when the decision reached that cue.
