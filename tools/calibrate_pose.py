@@ -69,7 +69,7 @@ def fit_closed_end(views: list[tuple]) -> tuple[ClosedEndModel | None, int]:
                           bias=float(fit.intercept_[0])), len(used)
 
 
-def decision(d, model: ClosedEndModel | None) -> tuple[str, str]:
+def decide(d, model: ClosedEndModel | None) -> tuple[str, str]:
     """(pose, cue) perception decides for a view with this closed-end model (the view was
     perceived with another: only the closed-end cue's decisions change)."""
     if d.pose_end is None or model is None:
@@ -106,7 +106,7 @@ def main(argv=None) -> int:
         print("the closed-end model needs upright and upside-down views: not fitted",
               file=sys.stderr)
     for pose, d in views:
-        counts["/".join(decision(d, model))][pose] += 1
+        counts["/".join(decide(d, model))][pose] += 1
     name = getattr(sensor, "name", type(sensor).__name__)
     out = {"source": f"tools/calibrate_pose.py --sensor {args.sensor} ({name}): {len(ids)} "
                      f"training objects, their resting poses at yaws {list(YAWS_DEG)}; {n} views, "

@@ -14,6 +14,7 @@ reads them too.
     .venv/bin/python tools/measure_perception.py --summary /tmp/p/results.jsonl
     .venv/bin/python tools/measure_perception.py --compare /tmp/run1.jsonl /tmp/run2.jsonl
     ... --database /tmp/kernel_db.npz  # another kernel database than the shipped one
+    ... --pose-calibration /tmp/pose.json  # another pose likelihood (tools/calibrate_pose.py)
 
 `--stride N` keeps every N-th case (in the suite's order), `--only ID` one object's cases;
 `--workers` processes (at most 2 on this machine). `--compare` lists the cases whose records
@@ -34,9 +35,12 @@ SUITE = Path(__file__).resolve().parents[1] / "scenarios" / "suites" / "generali
 MEASURED = ("category_kernel", "category_plm", "pose", "parts")
 
 
-def _init(database: str | None) -> None:
+def _init(database: str | None, pose_calibration: str | None = None) -> None:
     from tg_drake.evaluation.split import load_split
     load_split().register_libraries()
+    if pose_calibration is not None:  # the pose likelihood of this process from that file
+        import tg_drake.perception.pose as pose
+        pose.CALIBRATION_FILE = Path(pose_calibration)
     if database is not None:  # every kernel prior of this process against that database
         import tg_drake.evaluation.jobs as jobs
         from tg_drake.kernels.database import load_database
@@ -49,14 +53,15 @@ def _run(case) -> list[dict]:
     return [{"job": case.key, **r} for r in (out if isinstance(out, list) else [out])]
 
 
-def run(cases, *, workers: int, database: str | None) -> list[dict]:
+def run(cases, *, workers: int, database: str | None, pose_calibration: str | None = None
+        ) -> list[dict]:
     records: list[dict] = []
     t0 = time.perf_counter()
     if workers <= 1:
-        _init(database)
+        _init(database, pose_calibration)
         results = map(_run, cases)
     else:
-        pool = multiprocessing.get_context("spawn").Pool(workers, _init, (database,))
+        pool = multiprocessing.get_context("spawn").Pool(workers, _init, (database, pose_calibration))
         results = pool.imap(_run, cases, chunksize=4)
     for i, recs in enumerate(results, start=1):
         records += recs
@@ -131,6 +136,7 @@ def main(argv=None) -> int:
     p.add_argument("--only", action="append", help="only this object's cases (repeatable)")
     p.add_argument("--workers", type=int, default=2, help="processes (default %(default)s)")
     p.add_argument("--database", help="kernel database .npz (default: the shipped one)")
+    p.add_argument("--pose-calibration", help="pose likelihood .json (default: the shipped one)")
     p.add_argument("--out", type=Path, help="write the records here (JSON lines)")
     p.add_argument("--summary", type=Path, help="only summarise these records")
     p.add_argument("--compare", type=Path, nargs=2, metavar=("A", "B"),
@@ -156,7 +162,8 @@ def main(argv=None) -> int:
         if args.only:
             cases = [c for c in cases if c.target_placement.id in set(args.only)]
         cases = cases[::args.stride]
-        records = run(cases, workers=args.workers, database=args.database)
+        records = run(cases, workers=args.workers, database=args.database,
+                      pose_calibration=args.pose_calibration)
         if args.out:
             args.out.parent.mkdir(parents=True, exist_ok=True)
             args.out.write_text("".join(json.dumps(r) + "\n" for r in records))

@@ -14,17 +14,17 @@ in order:
    handles at the rim (a cup's handle spans the middle of its side and says nothing).
 3. **Neck.** With no cavity seen, the top is closed. A top much narrower than the base over a
    body as wide as the base at mid-height is a neck: an upright bottle.
-4. **Closed end.** With no cavity seen, the end on top is closed: a lid (upright) or the
+4. **Taper.** A closed top narrower than the base otherwise, narrowing steadily from a rim on the
+   table (already at mid-height, or strongly at the top: a can's rolled rim narrows only its last
+   centimetre, and only a little), is the shape of a tapered open container (glass, cup, bowl,
+   pan) resting on its rim: upside-down.
+5. **Closed end.** A closed, straight end on top: a lid (upright) or the
    object's own base (upside-down), told by its shape rather than by the outline: a lid is
    recessed below a rim by a band of depths; a base is flat, or domed up from its centre (a
    can's bottom). `closed_end` measures the recess and the dome [m]; a logistic model fitted on
    perceived training views (`ClosedEndModel`, tools/calibrate_pose.py) decides ("lid" or
    "base"). Without enough points on the top (an open top seen from the side) or without a
-   fitted model, the next cues decide.
-5. **Taper.** A closed top narrower than the base otherwise, narrowing steadily from a rim on the
-   table (already at mid-height, or strongly at the top: a can's rolled rim narrows only its last
-   centimetre, and only a little), is the shape of a tapered open container (glass, cup, bowl,
-   pan) resting on its rim: upside-down.
+   fitted model, the next cue decides.
 6. Otherwise (closed and straight, like a can) the object is taken as upright: standing upright
    is the usual pose (the calibrated likelihood of this cue says how often that is wrong).
 
@@ -297,12 +297,12 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
             top_sign, cue = float(handle_end), "handle"
         elif r_high < cfg.neck_ratio * r_low and r_mid >= cfg.neck_body_ratio * r_low:
             top_sign, cue = 1.0, "neck"
-        elif (end := closed_end(c)) is not None and calibration.closed_end is not None:
-            upside_down = calibration.closed_end.p_upsidedown(end) > 0.5
-            top_sign, cue = (-1.0, "base") if upside_down else (1.0, "lid")
         elif r_high < cfg.taper_ratio * r_low and (r_mid < cfg.taper_body_ratio * r_low
                                                    or r_high < cfg.strong_taper_ratio * r_low):
             top_sign, cue = -1.0, "taper"
+        elif (end := closed_end(c)) is not None and calibration.closed_end is not None:
+            upside_down = calibration.closed_end.p_upsidedown(end) > 0.5
+            top_sign, cue = (-1.0, "base") if upside_down else (1.0, "lid")
         else:
             top_sign, cue = 1.0, "straight"
     else:
