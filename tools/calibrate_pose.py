@@ -15,6 +15,10 @@ view). Two fits on these views:
 
     .venv/bin/python tools/calibrate_pose.py  # → tg_drake/data/pose_likelihood.json
     .venv/bin/python tools/calibrate_pose.py --sensor ideal --out /tmp/pose.json
+    .venv/bin/python tools/calibrate_pose.py --sensor d415 --closed-end --out /tmp/pose.json
+
+Step 1 only with `--closed-end` (the shipped file holds no closed-end model: fitted on training
+views, it reads a flat closed top as a base, so flat-topped solids read upside-down).
 """
 
 from __future__ import annotations
@@ -82,6 +86,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sensor", choices=("default", "ideal", "d415"), default="default")
     parser.add_argument("--out", type=Path, default=CALIBRATION_FILE)
+    parser.add_argument("--closed-end", action="store_true",
+                        help="fit the closed-end model too (the cue is on where the file holds "
+                             "one; off by default: it reads flat-topped solids upside-down)")
     args = parser.parse_args(argv)
     sensor = {"default": DepthPerception().sensor, "ideal": IdealDepth(),
               "d415": StructuredLight()}[args.sensor]
@@ -101,8 +108,8 @@ def main(argv=None) -> int:
     if failed == n:
         print("no view perceived", file=sys.stderr)
         return 1
-    model, n_end = fit_closed_end(views)
-    if model is None:
+    model, n_end = fit_closed_end(views) if args.closed_end else (None, 0)
+    if model is None and args.closed_end:
         print("the closed-end model needs upright and upside-down views: not fitted",
               file=sys.stderr)
     for pose, d in views:
