@@ -53,8 +53,8 @@ from tg_drake.kernels.library import (
     library_fingerprint,
     perceived_views,
 )
-from tg_drake.perception.sensor_model import IdealDepth, StructuredLight
 from tg_drake.kernels.propagation import BIN_WIDTH, T_MAX, LshProjections
+from tg_drake.perception.sensor_model import IdealDepth, StructuredLight
 from tg_drake.types import CATEGORIES
 
 OUT = Path(__file__).resolve().parents[1] / "tg_drake" / "data" / "kernel_db.npz"
@@ -176,7 +176,8 @@ def main(argv=None) -> int:
     parser.add_argument("--sensor", choices=tuple(SENSORS), default="d415",
                         help="depth sensor model of the perceived views (default %(default)s)")
     parser.add_argument("--workers", type=int, default=1, help="processes perceiving views")
-    parser.add_argument("--viewpoints", type=int, default=1, choices=range(1, len(VIEWPOINTS) + 1),
+    parser.add_argument("--viewpoints", type=int, default=1,
+                        choices=range(1, len(VIEWPOINTS) + 1),
                         help="the first N of tg_drake.kernels.library.VIEWPOINTS (default "
                              "%(default)s: the default camera's, the evaluation's)")
     parser.add_argument("--check", action="store_true",

@@ -24,7 +24,6 @@ differ (the repeatability check: the same cases, the same seeds, must give the s
 from __future__ import annotations
 
 import argparse
-import collections
 import json
 import multiprocessing
 import sys
@@ -61,7 +60,8 @@ def run(cases, *, workers: int, database: str | None, pose_calibration: str | No
         _init(database, pose_calibration)
         results = map(_run, cases)
     else:
-        pool = multiprocessing.get_context("spawn").Pool(workers, _init, (database, pose_calibration))
+        pool = multiprocessing.get_context("spawn").Pool(workers, _init,
+                                                         (database, pose_calibration))
         results = pool.imap(_run, cases, chunksize=4)
     for i, recs in enumerate(results, start=1):
         records += recs

@@ -154,7 +154,7 @@ class PoseCalibration:
     prior_views: float = 2.0  # [views] weight of the smoothing prior
     source: str = ""  # how the counts were made (objects, sensor, command)
     # The closed-end model (`ClosedEndModel`) fitted on the same views, or None (the cue off).
-    closed_end: "ClosedEndModel | None" = None
+    closed_end: ClosedEndModel | None = None
 
     def likelihood(self, decision: str, cue: str) -> dict[str, float]:
         """P(true pose | decision, cue), over POSES (sums to 1)."""
