@@ -193,7 +193,8 @@ def main(argv=None) -> int:
             args.workers, object_ids, (args.objects,))  # registers the split's libraries
     try:
         db, summary = build(samplings=args.samplings, spacing=args.spacing, seed=args.seed,
-                            object_ids=ids, viewpoints=VIEWPOINTS[:args.viewpoints], sensor=SENSORS[args.sensor],
+                            object_ids=ids, viewpoints=VIEWPOINTS[:args.viewpoints],
+                            sensor=SENSORS[args.sensor],
                             map_fn=map if pool is None else
                             (lambda f, jobs: pool.imap(f, jobs, chunksize=8)))
     finally:
