@@ -1,17 +1,23 @@
 """Builds the kernel-prior database shipped with the package (tg_drake/data/kernel_db.npz).
 
-    python tools/build_kernel_db.py                 # 3 samplings + 18 perceived views per pose
+    nice -n 10 python tools/build_kernel_db.py --workers 2   # the shipped file
     python tools/build_kernel_db.py --check         # rebuild and compare with the shipped file
     python tools/build_kernel_db.py --samplings 5 --out /tmp/kernel_db.npz
+    python tools/build_kernel_db.py --objects all-a --sensor ideal  # the database before the split
 
-Two kinds of graphs per library object:
+The objects are the **training objects** of the object-wise split (`tg_drake.evaluation.split`:
+sets a and b), so that held-out objects are in no database graph (`--objects all-a`: every
+object of the shipped library, as before the split). Two kinds of graphs per object:
 
 - ground-truth samplings (`--samplings`): uniform on the mesh, random rotation, one point per
   voxel on a shifted grid, the mesh's part labels (the S_SYN analogue);
 - perceived views: the object alone on the table in each of its resting poses, turned by each
-  yaw of `tg_drake.kernels.library.VIEW_YAWS_DEG`, its depth image ray cast from each viewpoint of
-  `VIEWPOINTS` and put through our perception stage (`describe_scene`); the perceived cloud with
-  its estimated part labels, resampled like a query. A perceived query then meets perceived
+  yaw of `tg_drake.kernels.library.VIEW_YAWS_DEG` (between the evaluation suites' 0, 120, 240),
+  its depth image ray cast from each of the first `--viewpoints` of `VIEWPOINTS` (default: the
+  default camera's alone), measured by the evaluation's depth sensor model (the D415,
+  `--sensor`; seeded per view by `--seed`) and put through our perception stage
+  (`describe_scene`); the perceived cloud with its estimated part labels, resampled like a
+  query. A perceived query then meets perceived
   graphs, as the paper compared real scans with real scans.
 
 Then the LSH projections are drawn, every graph is hashed for t = 0..15, and the LSH bin width w,
@@ -21,8 +27,8 @@ graphs of all other objects, the choice with the best accuracy (then mean rank, 
 w, the smaller T) wins. The paper's w = 1e-4 is one of the candidates; the coarser bins that
 perceived clouds favour also keep the file small. The file holds the hashed counts, the
 projections, where each graph came from and the choice. Everything
-follows from `--seed` (perception and ray casting are deterministic), so a rebuild gives the same
-file; `--check` verifies that.
+follows from `--seed` (perception, ray casting and the seeded sensor model are deterministic, in
+any process), so a rebuild gives the same file; `--check` verifies that.
 """
 
 from __future__ import annotations
@@ -48,10 +54,25 @@ from tg_drake.kernels.library import (
     perceived_views,
 )
 from tg_drake.kernels.propagation import BIN_WIDTH, T_MAX, LshProjections
+from tg_drake.perception.sensor_model import IdealDepth, StructuredLight
 from tg_drake.types import CATEGORIES
 
 OUT = Path(__file__).resolve().parents[1] / "tg_drake" / "data" / "kernel_db.npz"
 BIN_WIDTHS = (BIN_WIDTH, 1e-3, 1e-2, 3e-2, 1e-1)  # LSH bin widths w cross-validated.
+# The evaluation's depth sensor (tg_drake.evaluation.jobs.EVALUATION_SENSOR, the D415 model).
+SENSORS = {"d415": StructuredLight(), "ideal": IdealDepth()}
+
+
+def object_ids(which: str) -> list[str]:
+    """The database's objects: the split's training objects (sets a and b) or all of set a."""
+    from tg_drake.evaluation.split import load_split  # a tool: may read the evaluation's split
+    from tg_drake.objects import load_library
+
+    if which == "all-a":
+        return list(load_library())
+    split = load_split()
+    split.register_libraries()
+    return list(split.train)
 
 
 def _progress(done: int, total: int) -> None:
@@ -84,20 +105,21 @@ def cross_validate(db: KernelDatabase, clouds: str = "perceived") -> tuple[dict,
 
 def build(*, samplings: int, spacing: float, seed: int, viewpoints=VIEWPOINTS,
           yaws_deg=VIEW_YAWS_DEG, object_ids=None, k: int = K_NEIGHBOURS,
-          widths=BIN_WIDTHS, views: tuple[list[dict], list[dict]] | None = None
-          ) -> tuple[KernelDatabase, dict]:
+          widths=BIN_WIDTHS, views: tuple[list[dict], list[dict]] | None = None,
+          sensor=None, map_fn=map) -> tuple[KernelDatabase, dict]:
     """The database and a summary of it (sizes, the cross-validated choice).
 
     `views`: (views, failures) from `perceived_views` when already perceived (else perceived
-    here). `widths`: the LSH bin widths to choose from; all share one draw of projections (the
-    offsets b scale with w)."""
+    here, through `sensor`, seeded by `seed`, mapped by `map_fn`). `widths`: the LSH bin widths
+    to choose from; all share one draw of projections (the offsets b scale with w)."""
     rng = np.random.default_rng(seed)
     clouds, ids, cats = library_clouds(n_samplings=samplings, spacing=spacing, rng=rng,
                                        object_ids=object_ids)
     n_gt = len(clouds)
     unit = LshProjections.sample(t_max=T_MAX, w=1.0, rng=rng)
     views, failures = views if views is not None else perceived_views(
-        object_ids=object_ids, viewpoints=viewpoints, yaws_deg=yaws_deg, progress=_progress)
+        object_ids=object_ids, viewpoints=viewpoints, yaws_deg=yaws_deg, sensor=sensor,
+        seed=seed, progress=_progress, map_fn=map_fn)
     kept, dropped = [], []
     for v in views:
         d = v["description"]
@@ -132,7 +154,7 @@ def build(*, samplings: int, spacing: float, seed: int, viewpoints=VIEWPOINTS,
     # own choice of entries and T at the chosen w.
     chosen_gt, _ = cross_validate(db, "ground_truth")
     db.t_ground_truth, db.entries_ground_truth = chosen_gt["T"], chosen_gt["entries"]
-    db.library_fingerprint = library_fingerprint()
+    db.library_fingerprint = library_fingerprint(sorted(set(ids)))
     sizes = np.array([len(c.labels) for c in clouds])
     return db, {"n_objects": len(set(ids)), "n_graphs": len(clouds), "n_ground_truth": n_gt,
                 "n_perceived": n_views, "perception_failures": failures,
@@ -149,12 +171,36 @@ def main(argv=None) -> int:
                         help="voxel size as a fraction of the object's size")
     parser.add_argument("--seed", type=int, default=0, help="seed of sampling and projections")
     parser.add_argument("--out", type=Path, default=OUT, help="output .npz")
+    parser.add_argument("--objects", choices=("train", "all-a"), default="train",
+                        help="the split's training objects (default) or all of set a")
+    parser.add_argument("--sensor", choices=tuple(SENSORS), default="d415",
+                        help="depth sensor model of the perceived views (default %(default)s)")
+    parser.add_argument("--workers", type=int, default=1, help="processes perceiving views")
+    parser.add_argument("--viewpoints", type=int, default=1,
+                        choices=range(1, len(VIEWPOINTS) + 1),
+                        help="the first N of tg_drake.kernels.library.VIEWPOINTS (default "
+                             "%(default)s: the default camera's, the evaluation's)")
     parser.add_argument("--check", action="store_true",
                         help="rebuild in memory and compare with --out instead of writing it")
     args = parser.parse_args(argv)
 
     t0 = time.perf_counter()
-    db, summary = build(samplings=args.samplings, spacing=args.spacing, seed=args.seed)
+    ids = object_ids(args.objects)
+    pool = None
+    if args.workers > 1:
+        import multiprocessing
+        pool = multiprocessing.get_context("spawn").Pool(
+            args.workers, object_ids, (args.objects,))  # registers the split's libraries
+    try:
+        db, summary = build(samplings=args.samplings, spacing=args.spacing, seed=args.seed,
+                            object_ids=ids, viewpoints=VIEWPOINTS[:args.viewpoints],
+                            sensor=SENSORS[args.sensor],
+                            map_fn=map if pool is None else
+                            (lambda f, jobs: pool.imap(f, jobs, chunksize=8)))
+    finally:
+        if pool is not None:
+            pool.close()
+            pool.join()
     print(f"{summary['n_graphs']} graphs of {summary['n_objects']} objects "
           f"({summary['n_ground_truth']} ground-truth samplings, {summary['n_perceived']} "
           f"perceived views; {len(summary['perception_failures'])} views without an object, "

@@ -1,15 +1,24 @@
 """Calibrates perception's pose likelihood on perceived views of the training objects.
 
-Every training object (the object-wise split's `train`: `tg_drake.evaluation.split`, or, until
-that exists, the library without its `*_04` objects) is perceived alone on the table in each of
-its resting poses at yaws the evaluation suites do not use, its depth image ray cast from the
-default camera's viewpoint and measured by the scenario default's depth sensor
-(`tg_drake.perception.render.perceive`). Per (decision, cue) — the pose perception decided and
-the cue that decided it — the true poses are counted; `tg_drake.perception.pose.PoseCalibration`
-turns the counts into P(true pose | decision, cue).
+Every training object (the object-wise split's `train`: `tg_drake.evaluation.split`, sets a and
+b) is perceived alone on the table in each of its resting poses at yaws the evaluation suites do
+not use, its depth image ray cast from the default camera's viewpoint and measured by the
+evaluation's depth sensor, the D415 model (`tg_drake.perception.render.perceive`, seeded per
+view). Two fits on these views:
+
+1. the closed-end model (`tg_drake.perception.pose.ClosedEndModel`): a logistic regression of
+   "upside-down" on the closed top's features (`ClosedEnd.features`) over the upright and
+   upside-down views whose pose decision reached that cue;
+2. per (decision, cue) — the pose perception decides (with that model) and the cue that decided
+   it — the true poses are counted; `PoseCalibration` turns the counts into P(true pose |
+   decision, cue).
 
     .venv/bin/python tools/calibrate_pose.py  # → tg_drake/data/pose_likelihood.json
     .venv/bin/python tools/calibrate_pose.py --sensor ideal --out /tmp/pose.json
+    .venv/bin/python tools/calibrate_pose.py --sensor d415 --closed-end --out /tmp/pose.json
+
+Step 1 only with `--closed-end` (the shipped file holds no closed-end model: fitted on training
+views, it reads a flat closed top as a base, so flat-topped solids read upside-down).
 """
 
 from __future__ import annotations
@@ -20,9 +29,17 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from tg_drake.errors import TgDrakeError
-from tg_drake.objects import load_library
-from tg_drake.perception.pose import CALIBRATION_FILE, PoseCalibration
+from tg_drake.evaluation.split import load_split
+from tg_drake.objects import get_object
+from tg_drake.perception.pose import (
+    CALIBRATION_FILE,
+    ClosedEnd,
+    ClosedEndModel,
+    PoseCalibration,
+)
 from tg_drake.perception.render import perceive
 from tg_drake.perception.sensor_model import IdealDepth, StructuredLight
 from tg_drake.scenario import DepthPerception
@@ -30,44 +47,83 @@ from tg_drake.scenario import DepthPerception
 # Yaws of the calibration views [deg]: between the S_REAL suite's 0, 120, 240.
 YAWS_DEG = (60.0, 180.0, 300.0)
 PRIOR_VIEWS = 2.0  # [views] the smoothing prior's weight (PoseCalibration.prior_views)
+# The closed-end model's L2 regularisation: sklearn's C (inverse strength) on features in mm.
+CLOSED_END_C = 1.0
 
 
 def training_ids() -> list[str]:
-    try:
-        from tg_drake.evaluation.split import load_split  # the object set's split, once it exists
-        return sorted(load_split().train)
-    except ImportError:
-        return sorted(i for i in load_library() if not i.endswith("_04"))
+    split = load_split()
+    split.register_libraries()
+    return list(split.train)
+
+
+def fit_closed_end(views: list[tuple]) -> tuple[ClosedEndModel | None, int]:
+    """The closed-end model fitted on (true pose, description) views whose decision reached the
+    cue, upright or upside-down; None with fewer than two classes. Returns (model, views used)."""
+    from sklearn.linear_model import LogisticRegression
+
+    used = [(pose, ClosedEnd(*d.pose_end)) for pose, d in views
+            if d.pose_end is not None and pose in ("upright", "upsidedown")]
+    y = np.array([pose == "upsidedown" for pose, _ in used])
+    if len(set(y.tolist())) < 2:
+        return None, len(used)
+    X = np.array([end.features() for _, end in used])
+    fit = LogisticRegression(C=CLOSED_END_C, max_iter=1000).fit(X, y)
+    return ClosedEndModel(weights=tuple(float(w) for w in fit.coef_[0]),
+                          bias=float(fit.intercept_[0])), len(used)
+
+
+def decide(d, model: ClosedEndModel | None) -> tuple[str, str]:
+    """(pose, cue) perception decides for a view with this closed-end model (the view was
+    perceived with another: only the closed-end cue's decisions change)."""
+    if d.pose_end is None or model is None:
+        return d.pose, d.pose_cue
+    upside_down = model.p_upsidedown(ClosedEnd(*d.pose_end)) > 0.5
+    return ("upsidedown", "base") if upside_down else ("upright", "lid")
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sensor", choices=("default", "ideal", "d415"), default="default")
     parser.add_argument("--out", type=Path, default=CALIBRATION_FILE)
+    parser.add_argument("--closed-end", action="store_true",
+                        help="fit the closed-end model too (the cue is on where the file holds "
+                             "one; off by default: it reads flat-topped solids upside-down)")
     args = parser.parse_args(argv)
     sensor = {"default": DepthPerception().sensor, "ideal": IdealDepth(),
               "d415": StructuredLight()}[args.sensor]
-    library = load_library()
     counts: dict = collections.defaultdict(lambda: collections.Counter())
     ids = training_ids()
     n = failed = 0
+    views = []
     for obj_id in ids:
-        for pose in library[obj_id].poses:
+        for pose in get_object(obj_id).poses:
             for yaw in YAWS_DEG:
                 try:
-                    d = perceive(obj_id, pose, yaw, sensor=sensor, seed=n)
+                    views.append((pose, perceive(obj_id, pose, yaw, sensor=sensor, seed=n)))
                 except TgDrakeError:
                     failed += 1
-                    continue
                 finally:
                     n += 1
-                counts[f"{d.pose}/{d.pose_cue}"][pose] += 1
+    if failed == n:
+        print("no view perceived", file=sys.stderr)
+        return 1
+    model, n_end = fit_closed_end(views) if args.closed_end else (None, 0)
+    if model is None and args.closed_end:
+        print("the closed-end model needs upright and upside-down views: not fitted",
+              file=sys.stderr)
+    for pose, d in views:
+        counts["/".join(decide(d, model))][pose] += 1
     name = getattr(sensor, "name", type(sensor).__name__)
     out = {"source": f"tools/calibrate_pose.py --sensor {args.sensor} ({name}): {len(ids)} "
                      f"training objects, their resting poses at yaws {list(YAWS_DEG)}; {n} views, "
                      f"{failed} not perceived",
            "prior_views": PRIOR_VIEWS,
            "counts": {k: dict(sorted(v.items())) for k, v in sorted(counts.items())}}
+    if model is not None:
+        out["closed_end"] = {"weights": list(model.weights), "bias": model.bias,
+                             "features": "recess [mm], dome [mm], recess² [mm²]",
+                             "views": n_end, "C": CLOSED_END_C}
     args.out.write_text(json.dumps(out, indent=1) + "\n")
     calibration = PoseCalibration(counts=out["counts"], prior_views=PRIOR_VIEWS)
     for key in out["counts"]:
@@ -75,6 +131,11 @@ def main(argv=None) -> int:
         p = calibration.likelihood(decision, cue)
         print(f"{key:22s} {dict(out['counts'][key])}  →  " + ", ".join(
             f"{k} {v:.2f}" for k, v in p.items()))
+    if model is not None:
+        ends = [(pose, ClosedEnd(*d.pose_end)) for pose, d in views if d.pose_end is not None
+                and pose in ("upright", "upsidedown")]
+        right = sum((model.p_upsidedown(e) > 0.5) == (pose == "upsidedown") for pose, e in ends)
+        print(f"closed-end model on {n_end} views: training accuracy {right / len(ends):.3f}")
     print(f"wrote {args.out} ({n} views, {failed} not perceived)")
     return 0
 

@@ -48,3 +48,34 @@ def test_the_shipped_calibration_loads_and_a_bad_file_is_a_clear_error(tmp_path)
         load_pose_calibration(str(bad))
     with pytest.raises(PerceptionError, match="no such"):
         load_pose_calibration(str(tmp_path / "missing.json"))
+
+
+def _closed_top_cylinder(top_height):
+    """Visible points of a 30 mm radius, 120 mm tall cylinder standing on the table (its half
+    towards +x, and its whole top surface at the heights `top_height(r)` [m])."""
+    from types import SimpleNamespace
+
+    R, H, step = 0.03, 0.12, 0.0015
+    th = np.linspace(-np.pi / 2, np.pi / 2, 60)
+    wall = np.array([(R * np.cos(t), R * np.sin(t), z) for t in th
+                     for z in np.arange(0.004, H, 0.003)])
+    g = np.arange(-R, R + step, step)
+    x, y = np.meshgrid(g, g)
+    r = np.hypot(x, y)
+    top = np.c_[x[r <= R], y[r <= R], [top_height(v) for v in r[r <= R]]]
+    p = np.vstack([wall, top])
+    n = len(p)
+    return SimpleNamespace(p_T=p, visible=np.ones(n, bool), handle=np.zeros(n, bool),
+                           p_TA=np.array([0.0, 0.0, H / 2]))
+
+
+def test_the_closed_end_measures_a_recessed_lid_a_flat_and_a_domed_base():
+    from tg_drake.perception.pose import closed_end
+
+    H = 0.12
+    lid = closed_end(_closed_top_cylinder(lambda r: H if r > 0.0225 else H - 0.004))
+    flat = closed_end(_closed_top_cylinder(lambda r: H))
+    domed = closed_end(_closed_top_cylinder(lambda r: H - 0.008 * max(0.0, 1 - r / 0.02)))
+    assert lid.recess == pytest.approx(0.004, abs=2e-4) and abs(lid.dome) < 2e-4
+    assert abs(flat.recess) < 2e-4 and abs(flat.dome) < 2e-4
+    assert domed.recess > 0.004 and domed.dome > 0.0015  # [m] the dome rises off its centre

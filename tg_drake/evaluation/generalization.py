@@ -140,10 +140,11 @@ PROTOCOL = """\
 - **What is fit on what.** Every threshold, likelihood and learned model (the hold model of the
   feasibility stage, the perception likelihoods, the kernel database, a learned theory) is fit on
   training objects only (their generated and scan-like versions) and reported here on both sides;
-  nothing is tuned on the suites below. Models shipped before this protocol were built on all of
-  set a: the kernel database holds every set-a object (queried leave-one-object-out) and the DGI
+  nothing is tuned on the suites below. The kernel database holds the training objects of sets
+  a and b only (perceived through the D415 model; training objects are queried
+  leave-one-object-out). Models shipped before this protocol were built on all of set a: the DGI
   was trained on grasps of all 44 (docs/results/dgi.json `n_objects`), so set a's held-out
-  figures are not held out yet for them; set b's objects are in neither.
+  figures are not held out yet for it; set b's objects are not in it.
 - **Measures**: those of `docs/results/tables.md` (`tg_drake.evaluation.tables`): category from
   the argmax, ties failing; pose and parts as detected; pre-grasp E0 on set-valued ground truth;
   executed runs: grasped and placed of the runs with a reachable pre-grasp, executed E0 (the

@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from tg_drake.kernels.database import ENTRIES
+from tg_drake.kernels.library import VIEW_YAWS_DEG
 from tg_drake.kernels.prior import N_NEIGHBOURS, category_priors, is_correct, true_category_rank
 from tg_drake.types import CATEGORIES
 
@@ -153,7 +154,8 @@ def evaluate_members(db, queries, *, entries=None, t_values=None,
         t_values=t_values, n_neighbours=n_neighbours)
 
 
-QUERY_YAWS_DEG = (0.0, 120.0, 240.0)  # yaws of the perceived queries of the evaluation,
+QUERY_YAWS_DEG = VIEW_YAWS_DEG  # yaws of the perceived queries of the evaluation (the
+# database's perceived views, whose yaws the evaluation suites' do not share),
 QUERY_VIEWPOINT = 0  # from the default scenario camera's viewpoint (library.VIEWPOINTS[0]).
 
 

@@ -16,6 +16,7 @@ differ in where the points fall, so they are different graphs of the same shape.
 from __future__ import annotations
 
 import hashlib
+import zlib
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -63,42 +64,66 @@ def library_clouds(*, n_samplings: int, spacing: float = SPACING, rng: np.random
 # higher and farther.
 VIEWPOINTS = (P_CAMERA, (0.65, 0.0, 0.40), (0.9, 0.0, 0.80))
 VIEW_TARGET = P_TARGET
-VIEW_YAWS_DEG = (0.0, 60.0, 120.0, 180.0, 240.0, 300.0)  # object turns about the table normal.
+VIEW_YAWS_DEG = (60.0, 180.0, 300.0)  # [deg] object turns about the table normal: between the
+# evaluation suites' yaws 0, 120, 240.
+
+
+def view_seed(obj_id: str, pose: str, view: int, yaw_deg: float, seed: int = 0) -> int:
+    """The depth sensor's seed of one perceived view: a function of the view alone (not of the
+    order views are perceived in), so views perceived in any process agree."""
+    return zlib.crc32(f"{obj_id}/{pose}/{view}/{yaw_deg:g}".encode()) + 1_000_003 * seed
+
+
+def perceive_view(job: tuple) -> dict:
+    """One perceived view: job = (object id, category, pose, viewpoint index, yaw [deg],
+    viewpoints, sensor, seed). A dict with object, category, pose, yaw, view and description
+    (the perceived `ObjectDescription`), or a reason instead of the description (perception
+    found no object)."""
+    obj_id, category, pose, v, yaw, viewpoints, sensor, seed = job
+    entry = {"object": obj_id, "category": category, "pose": pose, "yaw": float(yaw), "view": v}
+    try:
+        return {**entry, "description": perceive(
+            obj_id, pose, yaw, p_camera=viewpoints[v], p_target=VIEW_TARGET, sensor=sensor,
+            seed=view_seed(obj_id, pose, v, yaw, seed))}
+    except PerceptionError as e:
+        return {**entry, "reason": str(e)}
 
 
 def perceived_views(*, object_ids=None, viewpoints=VIEWPOINTS, yaws_deg=VIEW_YAWS_DEG,
-                    progress=None) -> tuple[list[dict], list[dict]]:
+                    sensor=None, seed: int = 0, progress=None, map_fn=map
+                    ) -> tuple[list[dict], list[dict]]:
     """Perceived clouds of library objects, one per resting pose × viewpoint × yaw
-    (`tg_drake.perception.render.perceive`: the depth image ray cast, then `describe_scene`).
+    (`tg_drake.perception.render.perceive`: the depth image ray cast, measured by `sensor` — a
+    `perception.sensor_model` model, None: the exact image — seeded per view (`view_seed`),
+    then `describe_scene`).
 
-    Returns (views, failures) in library order. A view is a dict with object, category, pose,
-    yaw, view (index into `viewpoints`) and description (the perceived `ObjectDescription`);
-    a failure has a reason instead (perception found no object). `progress(done, total)` is
-    called after each view.
+    Returns (views, failures) in the objects' order. A view is a dict with object, category,
+    pose, yaw, view (index into `viewpoints`) and description (the perceived
+    `ObjectDescription`); a failure has a reason instead (perception found no object).
+    `progress(done, total)` is called after each view; `map_fn` maps `perceive_view` over the
+    jobs (a process pool's imap to spread them, in order).
     """
     objects = list(load_library().values()) if object_ids is None else \
         [get_object(i) for i in object_ids]
-    jobs = [(obj, pose, v, yaw) for obj in objects for pose in obj.poses
+    jobs = [(obj.id, obj.category, pose, v, float(yaw), tuple(viewpoints), sensor, seed)
+            for obj in objects for pose in obj.poses
             for v in range(len(viewpoints)) for yaw in yaws_deg]
     views, failures = [], []
-    for done, (obj, pose, v, yaw) in enumerate(jobs, start=1):
-        entry = {"object": obj.id, "category": obj.category, "pose": pose, "yaw": float(yaw),
-                 "view": v}
-        try:
-            views.append({**entry, "description": perceive(
-                obj.id, pose, yaw, p_camera=viewpoints[v], p_target=VIEW_TARGET)})
-        except PerceptionError as e:
-            failures.append({**entry, "reason": str(e)})
+    for done, view in enumerate(map_fn(perceive_view, jobs), start=1):
+        (views if "description" in view else failures).append(view)
         if progress is not None:
             progress(done, len(jobs))
     return views, failures
 
 
-def library_fingerprint() -> str:
+def library_fingerprint(object_ids=None) -> str:
     """SHA-256 of what the database depends on: every object's id, category, mesh and part
-    labels, in library order. A database whose fingerprint differs is stale."""
+    labels, in library order (or of `object_ids`, sorted: the database's objects). A database
+    whose fingerprint differs is stale."""
     digest = hashlib.sha256()
-    for obj in load_library().values():
+    objects = load_library().values() if object_ids is None else \
+        [get_object(i) for i in sorted(object_ids)]
+    for obj in objects:
         V, F, L = mesh(obj)
         digest.update(f"{obj.id}:{obj.category}:{V.shape}:{F.shape};".encode())
         for a in (V, F, L):

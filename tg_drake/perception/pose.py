@@ -18,9 +18,15 @@ in order:
    table (already at mid-height, or strongly at the top: a can's rolled rim narrows only its last
    centimetre, and only a little), is the shape of a tapered open container (glass, cup, bowl,
    pan) resting on its rim: upside-down.
-5. Otherwise (closed and straight, like a can) the object is taken as upright: standing upright
-   is the usual pose, and an upside-down straight container looks the same from above (the
-   calibrated likelihood of this cue says how often that is wrong).
+5. **Closed end.** A closed, straight end on top: a lid (upright) or the
+   object's own base (upside-down), told by its shape rather than by the outline: a lid is
+   recessed below a rim by a band of depths; a base is flat, or domed up from its centre (a
+   can's bottom). `closed_end` measures the recess and the dome [m]; a logistic model fitted on
+   perceived training views (`ClosedEndModel`, tools/calibrate_pose.py) decides ("lid" or
+   "base"). Without enough points on the top (an open top seen from the side) or without a
+   fitted model, the next cue decides.
+6. Otherwise (closed and straight, like a can) the object is taken as upright: standing upright
+   is the usual pose (the calibrated likelihood of this cue says how often that is wrong).
 
 For a horizontal axis without a cavity or a handle at one end, the narrower end is the top (the
 neck of a bottle lying down); equal ends keep the axis direction.
@@ -70,6 +76,70 @@ HANDLE_END = 0.4
 EQUAL_ENDS = 0.05
 
 
+# The closed end on top of a vertical object (`closed_end`): the top band holds the visible body
+# points within END_BAND of the highest [m] (deeper than a recessed lid or a domed base); its
+# centre the points within END_CENTRE of the end's radius from the axis, its middle band those
+# between END_CENTRE and END_MIDDLE, its ring those beyond END_RING; each needs END_MIN_POINTS.
+END_BAND = 0.02
+END_CENTRE, END_MIDDLE, END_RING = 0.35, 0.6, 0.7
+END_MIN_POINTS = 10
+# The highest points of the ring: this quantile of their heights (a rim's crest, above the side
+# wall's points in the band).
+END_CREST_QUANTILE = 0.9
+
+
+@dataclass(frozen=True)
+class ClosedEnd:
+    """What the closed end on top of a vertical object shows (`closed_end`) [m]."""
+
+    recess: float  # the ring's crest above the centre: a recessed lid, a domed base, 0 if flat.
+    dome: float  # the middle band above the centre: a domed end's rise, 0 if flat.
+
+    def features(self) -> np.ndarray:
+        """The closed-end model's features (`ClosedEndModel`): recess [mm], dome [mm] and
+        recess² [mm²] (a lid is recessed by a band of depths: a flat base less, a domed one
+        more)."""
+        recess, dome = 1e3 * self.recess, 1e3 * self.dome
+        return np.array([recess, dome, recess ** 2])
+
+
+def closed_end(c: Completion) -> ClosedEnd | None:
+    """The shape of the closed end on top of a vertical object from its visible points, or None
+    when the top band shows too few points at the centre, in the middle or on the ring (an open
+    top seen from the side, a narrow neck)."""
+    vis = c.visible & ~c.handle
+    p = c.p_T[vis]
+    if len(p) < 3 * END_MIN_POINTS:
+        return None
+    z = p[:, 2]
+    band = z > z.max() - END_BAND
+    r = np.linalg.norm(p[band, :2] - c.p_TA[:2], axis=1)
+    zb = z[band]
+    r_end = float(np.quantile(r, RADIUS_QUANTILE)) if len(r) else 0.0
+    centre = r < END_CENTRE * r_end
+    middle = (r >= END_CENTRE * r_end) & (r < END_MIDDLE * r_end)
+    ring = r > END_RING * r_end
+    if min(centre.sum(), middle.sum(), ring.sum()) < END_MIN_POINTS:
+        return None
+    z_centre = float(np.median(zb[centre]))
+    return ClosedEnd(recess=float(np.quantile(zb[ring], END_CREST_QUANTILE)) - z_centre,
+                     dome=float(np.median(zb[middle])) - z_centre)
+
+
+@dataclass(frozen=True)
+class ClosedEndModel:
+    """P(upside-down | a closed end on top): a logistic regression on `ClosedEnd.features` [mm],
+    fitted on perceived views of the training objects (tools/calibrate_pose.py). A recessed
+    flat lid says upright; a flat base or a domed one (a container's bottom) says upside-down."""
+
+    weights: tuple[float, ...]  # one per feature [1/mm, 1/mm, 1/mm²]
+    bias: float
+
+    def p_upsidedown(self, end: ClosedEnd) -> float:
+        x = float(np.dot(self.weights, end.features())) + self.bias
+        return float(1.0 / (1.0 + np.exp(-x)))
+
+
 @dataclass(frozen=True)
 class PoseCalibration:
     """Counts of the true pose among perceived training views, per (decision, cue) key
@@ -83,6 +153,8 @@ class PoseCalibration:
     counts: dict = field(default_factory=dict)  # key → {pose: count}
     prior_views: float = 2.0  # [views] weight of the smoothing prior
     source: str = ""  # how the counts were made (objects, sensor, command)
+    # The closed-end model (`ClosedEndModel`) fitted on the same views, or None (the cue off).
+    closed_end: ClosedEndModel | None = None
 
     def likelihood(self, decision: str, cue: str) -> dict[str, float]:
         """P(true pose | decision, cue), over POSES (sums to 1)."""
@@ -109,8 +181,11 @@ def load_pose_calibration(path: str = "") -> PoseCalibration:
         return PoseCalibration()
     try:
         d = json.loads(file.read_text())
-        return PoseCalibration(counts=d["counts"], prior_views=float(d["prior_views"]),
-                               source=d.get("source", ""))
+        end = d.get("closed_end")
+        return PoseCalibration(
+            counts=d["counts"], prior_views=float(d["prior_views"]), source=d.get("source", ""),
+            closed_end=None if end is None else ClosedEndModel(
+                weights=tuple(float(w) for w in end["weights"]), bias=float(end["bias"])))
     except (ValueError, KeyError, TypeError) as e:
         raise PerceptionError(f"{file}: not a pose calibration ({e})") from None
 
@@ -120,10 +195,11 @@ class PoseEstimate:
     pose: str  # the decision: the axis first (vertical or not), then which end is the top.
     likelihood: dict[str, float]  # POSES entry → probability (sums to 1).
     top_sign: float  # +1 when the object's top is at the positive end of the axis, else −1.
-    cue: str  # the cue that placed the top: "cavity", "handle", "neck", "taper", "straight",
-    # or "ends".
+    cue: str  # the cue that placed the top: "cavity", "handle", "neck", "lid", "base",
+    # "taper", "straight", or "ends".
     inward_points: int = 0  # visible body points whose normal points into the object ...
     inward_share: float = 0.0  # ... and their share of the visible body points.
+    end: ClosedEnd | None = None  # the closed end on top, when the decision reached that cue.
 
 
 def inward_facing(p: np.ndarray, n: np.ndarray, p_A: np.ndarray, a: np.ndarray) -> np.ndarray:
@@ -204,6 +280,8 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
     likelihood is the calibrated P(true pose | decision, cue) (`PoseCalibration`).
     """
     cfg = cfg or PoseConfig()
+    calibration = load_pose_calibration(cfg.calibration)
+    end = None
     vis = c.visible & ~c.handle
     p_vis = c.p_T[vis]
     inward = inward_facing(p_vis, n_visible_T[~c.handle[c.visible]], c.p_TA, c.axis_T)
@@ -222,6 +300,9 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
         elif r_high < cfg.taper_ratio * r_low and (r_mid < cfg.taper_body_ratio * r_low
                                                    or r_high < cfg.strong_taper_ratio * r_low):
             top_sign, cue = -1.0, "taper"
+        elif (end := closed_end(c)) is not None and calibration.closed_end is not None:
+            upside_down = calibration.closed_end.p_upsidedown(end) > 0.5
+            top_sign, cue = (-1.0, "base") if upside_down else (1.0, "lid")
         else:
             top_sign, cue = 1.0, "straight"
     else:
@@ -236,7 +317,7 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
         else:
             top_sign, cue = 1.0, "ends"
     pose = "sideways" if not c.vertical else ("upright" if top_sign > 0 else "upsidedown")
-    likelihood = load_pose_calibration(cfg.calibration).likelihood(pose, cue)
+    likelihood = calibration.likelihood(pose, cue)
     total = sum(likelihood.values())
     return PoseEstimate(pose, {k: likelihood[k] / total for k in POSES}, top_sign, cue,
-                        int(inward.sum()), float(inward.mean()) if len(inward) else 0.0)
+                        int(inward.sum()), float(inward.mean()) if len(inward) else 0.0, end)
