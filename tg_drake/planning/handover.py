@@ -49,6 +49,7 @@ from tg_drake.grasping.feasibility import (
     gripper_boxes,
 )
 from tg_drake.robot import WSG_MAX_OPENING
+from tg_drake.tasks.judge import PASS_HOLD_DURATION
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription
 
 UP = np.array([0.0, 0.0, 1.0])
@@ -78,8 +79,8 @@ class ReceiverConfig:
     squeeze_duration: float = 0.1  # [s]
     settle_duration: float = 0.4  # [s] held closed before the robot opens
     closed_width: float = -0.04  # [m] commanded past closed, as the robot's (PlannerConfig)
-    hold_duration: float = 1.0  # [s] after the robot's release, the receiver must hold this long
-    # (the task's success test)
+    hold_duration: float = PASS_HOLD_DURATION  # [s] after the robot's release, the receiver must
+    # hold it alone this long (the task's success test, tg_drake.tasks.judge.judge_pass)
     kp: float = 20000.0  # [N/m] the mount's prismatic PD gains (the receiver and a held object
     kd: float = 1000.0  # [N·s/m] of 1 kg sag mg/kp = 0.5 mm)
     kp_rotation: float = 500.0  # [N·m/rad] the revolute joints' (0.3 kg·m weight at 0.1 m: 2 mrad)
@@ -296,7 +297,8 @@ class HandoverMotion:
     widths: tuple  # (L,) commanded opening [m], linear between the knots
     t_closed: float  # [s] the receiver's fingers have closed and settled
     X_WR_grasp: np.ndarray  # 4×4 its grasp pose
-    part: str = ""
+    part: str = ""  # the part it takes
+    hold_duration: float = PASS_HOLD_DURATION  # [s] it must hold it alone after the release
 
     def _segment(self, t: float):
         times = self.times
@@ -352,4 +354,5 @@ def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_start: float
         times=(0.0, t_start, t_pre, t_at), q=np.array([q_wait, q_wait, q_pre, q_grasp]),
         width_times=(0.0, t_at, t_zero, t_squeezed),
         widths=(WSG_MAX_OPENING, WSG_MAX_OPENING, 0.0, c.closed_width),
-        t_closed=t_closed, X_WR_grasp=np.array(grasp.X_WR, float), part=grasp.part)
+        t_closed=t_closed, X_WR_grasp=np.array(grasp.X_WR, float), part=grasp.part,
+        hold_duration=c.hold_duration)
