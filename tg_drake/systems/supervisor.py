@@ -460,7 +460,8 @@ class Supervisor(LeafSystem):
         key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, *handover, plan.duration)
         key_time = key_times[memory.checks_passed]
         if memory.t_released is not None and t < key_time:  # pass: the height while held
-            z = self._poses_port.Eval(context)[self._model.object_body].translation()[2]
+            X = self._poses_port.Eval(context)[self._model.object_body]
+            z = X.multiply(np.array(self._model.p_OC))[2]  # its box centre
             return dataclasses.replace(memory, z_released=memory.z_released + (float(z),))
         if t < key_time:
             return memory
@@ -490,7 +491,8 @@ class Supervisor(LeafSystem):
             return dataclasses.replace(memory, checks_passed=3, held_at_pour=hand.held)
         if memory.checks_passed == 2 and handover:  # pass: the robot has let go
             return dataclasses.replace(memory, checks_passed=3, t_released=context.get_time(),
-                                       z_released=(float(X_WO.translation()[2]),))
+                                       z_released=(float(X_WO.multiply(
+                                           np.array(self._model.p_OC))[2]),))
         if handover:  # pass: the receiver has held it alone to the end of the plan
             task = self._judge_pass(context, memory, contacts, hand, X_WO)
             detail = ("handed over: " if task.success else "let go at the hand-over; ") \
@@ -559,7 +561,7 @@ class Supervisor(LeafSystem):
             return TaskOutcome("pass", False, {}, "the station has no receiver")
         got = hand_contact(contacts, wsg_q=self._receiver_port.Eval(context)[:2],
                            geometries=receiver)
-        z = memory.z_released + (float(X_WO.translation()[2]),)
+        z = memory.z_released + (float(X_WO.multiply(np.array(self._model.p_OC))[2]),)
         return judge_pass(receiver_left=got.left, receiver_right=got.right,
                           receiver_opening=got.opening,
                           robot_touches=hand.left or hand.right,
