@@ -8,14 +8,14 @@
 % does not show are dropped, rules/README.md "The receiver of a pass").
 %
 % A person takes a tool by its handle (the paper's pass, IV: the robot holds the usable area so
-% that the handle is free); offered the head or blade, they take it there only when the robot
-% holds the handle. A pot or pan is taken by its handle, or by its body when the robot holds the
+% that the handle is free); when the robot holds the handle, by the handle's free end beside the
+% robot's fingers where there is room (the feasibility check decides), else by the head or blade. A pot or pan is taken by its handle, or by its body when the robot holds the
 % handle. A cup, glass or bowl is taken round its body, by the side the robot leaves free, or
 % under it or by its rim. A bottle or can is taken round its body, or by its top or bottom end.
 
 % ---- tool ----
 0.9::receive(X, handle); 0.1::receive(X, usable_area) :- kind(X, tool), held(X, usable_area).
-1.0::receive(X, usable_area) :- kind(X, tool), held(X, handle).
+0.7::receive(X, handle); 0.3::receive(X, usable_area) :- kind(X, tool), held(X, handle).
 
 % ---- kitchen_container (pan, pot) ----
 0.5::receive(X, middle); 0.3::receive(X, top); 0.2::receive(X, handle) :-

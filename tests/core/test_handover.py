@@ -134,12 +134,13 @@ def test_the_receiver_waits_back_and_above_the_hand_over_point():
 
 def test_the_receivers_motion_reaches_its_grasp_then_closes():
     grasp, _ = choose([-0.07])
-    motion = receiver_motion(HANDOVER, grasp, t_start=10.0)
+    motion = receiver_motion(HANDOVER, grasp, t_arrive=20.0, t_earliest=5.0)
     q_wait = mount_configuration(HANDOVER.X_WR_wait)
     assert np.allclose(motion.configuration(5.0), q_wait)
     assert np.allclose(motion.velocity(5.0), 0.0)
     assert np.allclose(mount_pose(motion.configuration(motion.times[-1] + 1)), grasp.X_WR)
     t_pre = motion.times[2]
+    assert motion.times[1] > 5.0 and t_pre == pytest.approx(20.0) and motion.times[3] == 20.0
     X_pre = mount_pose(motion.configuration(t_pre))
     assert np.allclose(X_pre[:3, 3], grasp.X_WR[:3, 3] - 0.1 * grasp.X_WR[:3, 1])
     assert motion.width(t_pre) == pytest.approx(0.11)
@@ -157,8 +158,8 @@ def test_a_receiver_with_a_bad_field_is_refused_naming_it():
 def test_the_logic_names_the_handle_of_a_tool_for_the_receiver():
     parts = receiver_parts({"knife": 1.0}, held="usable_area", parts=("handle", "usable_area"))
     assert list(parts) == ["handle", "usable_area"] and parts["handle"] == pytest.approx(0.9)
-    assert receiver_parts({"knife": 1.0}, held="handle",
-                          parts=("handle", "usable_area")) == {"usable_area": 1.0}
+    held = receiver_parts({"knife": 1.0}, held="handle", parts=("handle", "usable_area"))
+    assert held == pytest.approx({"handle": 0.7, "usable_area": 0.3})
     # A cup held by its middle is taken by its middle's other side first.
     cup = receiver_parts({"cup": 1.0}, held="middle", parts=("top", "middle", "bottom"))
     assert max(cup, key=cup.get) == "middle" and sum(cup.values()) == pytest.approx(1.0)
@@ -189,3 +190,13 @@ def test_judge_pass_success_is_the_receivers_steady_hold_alone():
 def test_judge_pass_failures_say_why(change, words):
     outcome = judged(**change)
     assert not outcome.success and words in outcome.detail, outcome
+
+
+def test_a_turned_receiver_grasp_keeps_its_grasp_point_and_closes_across_the_approach():
+    from tg_drake.planning.handover import turned_about_width
+
+    X = top_grasp(-0.07, 0.3)
+    for V in turned_about_width(X):
+        assert np.allclose(V[:3, 3] + GRASP_DEPTH * V[:3, 1], [-0.07, 0.0, 0.3])
+        assert np.allclose(V[:3, 2], X[:3, 2])  # the pads' width axis kept
+        assert abs(V[:3, 0] @ X[:3, 1]) == pytest.approx(1.0)  # closes along the old approach

@@ -22,11 +22,13 @@ scene it perceives is the table's). Its mount reaches at most `reach` from where
 
 The receiver's grasp (`choose_receiver_grasp`): the grasp candidates on the parts the logic names
 for a receiver (`tg_drake.logic.receive.receiver_parts`, given the part the robot holds), carried
-with the object into its hand-over pose; those whose approach is within `max_approach_angle` of the
-receiver's direction and within its reach are checked by the feasibility core
-(`tg_drake.grasping.feasibility.grasp_feasibility`): clear of the robot's gripper — its housing
-and its pads open, swept back along the robot's retreat — and of the table, with something
-between the pads; the best P(part) · P(grasp | local shape) · P(hold) is chosen.
+with the object into its hand-over pose, each also turned ±90° about its pads' width axis
+(`turned_about_width`: from the sides the table closed); those whose approach is within
+`max_approach_angle` of the receiver's direction and within its reach are checked by the
+feasibility core (`tg_drake.grasping.feasibility.grasp_feasibility`): clear of the robot's
+gripper — its housing and its pads open, swept back along the robot's retreat — and of the table,
+with something between the pads. Chosen: the best P(part) · P(grasp | local shape) · P(hold) among
+those whose contact mechanics carry the weight (combined margin ≥ 1), else among all.
 
 The receiver's motion (`receiver_motion`, mount joint space, smooth in time): from where it waits
 to its pre-grasp (`approach` back along +y_R from the grasp), a straight approach, the fingers
@@ -44,6 +46,7 @@ import numpy as np
 
 from tg_drake.errors import ScenarioError
 from tg_drake.grasping.feasibility import (
+    GRASP_DEPTH,
     FeasibilityConfig,
     grasp_feasibility,
     gripper_boxes,
@@ -72,8 +75,9 @@ class ReceiverConfig:
     approach: float = 0.1  # [m] its pre-grasp stands this far back along −y_R from its grasp
     max_approach_angle: float = 90.0  # [deg] its approach +y_R at most this far from its
     # direction (90: any approach from its side of the object, from above included)
-    speed: float = 0.3  # [m/s] moving to its pre-grasp (and [rad/s] turning)
-    approach_speed: float = 0.05  # [m/s] the straight approach
+    speed: float = 0.5  # [m/s] moving to its pre-grasp (and [rad/s] turning), while the robot
+    # carries the object, so as to be there when it arrives
+    approach_speed: float = 0.1  # [m/s] the straight approach (peak: 1.875 × the mean)
     close_duration: float = 0.8  # [s] open → 0 (then → closed_width over squeeze_duration), as
     # the robot's gripper closes (PlannerConfig)
     squeeze_duration: float = 0.1  # [s]
@@ -228,6 +232,7 @@ class ReceiverGrasp:
     p_local: float
     p_hold: float
     score: float  # p_part · p_local · p_hold
+    margin: float = float("inf")  # the contact mechanics' combined hold margin (< 1 slips)
 
 
 def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescription,
@@ -250,9 +255,12 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     if not len(on_part):
         return None, (f"hand-over: no receiver grasp candidate on the parts a receiver takes "
                       f"({wanted})")
-    # The candidates carried with the object: X_WR = X_WO_handover · X_WO⁻¹ · X_WG.
+    # The candidates carried with the object (X_WR = X_WO_handover · X_WO⁻¹ · X_WG), each also
+    # turned about its pads' width axis (`turned_about_width`).
     moved = np.asarray(X_WO_handover, float) @ np.linalg.inv(np.asarray(X_WO, float))
-    X_WR = np.einsum("ij,njk->nik", moved, np.asarray(candidates.X_WG, float)[on_part])
+    carried = np.einsum("ij,njk->nik", moved, np.asarray(candidates.X_WG, float)[on_part])
+    X_WR = np.array([V for X in carried for V in (X, *turned_about_width(X))])
+    on_part = np.repeat(on_part, 1 + len(TURNS))
     cos_max = math.cos(math.radians(config.max_approach_angle))
     toward = X_WR[:, :3, 1] @ handover.direction >= cos_max - 1e-9
     wait = handover.X_WR_wait[:3, 3]
@@ -277,10 +285,34 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     idx = on_part[keep]
     p_local = np.asarray(candidates.p_local, float)[idx]
     score = np.where(ok, p_recv[idx] * p_local * f.p_hold, -1.0)
-    best = int(np.argmax(score))
+    # Poses whose contact mechanics hold the weight (margin ≥ 1) first, then by score.
+    margin = np.array([h.margin >= 1.0 for h in f.holds], bool) & ok
+    best = int(np.argmax(score + 2.0 * margin))  # scores lie in [0, 1]
     i = int(idx[best])
     return ReceiverGrasp(X_WR[keep][best], names[i], i, float(p_recv[i]), float(p_local[best]),
-                         float(f.p_hold[best]), float(score[best])), ""
+                         float(f.p_hold[best]), float(score[best]),
+                         float(f.holds[best].margin)), ""
+
+
+TURNS = (np.pi / 2, -np.pi / 2)  # [rad] the turns of `turned_about_width`
+
+
+def turned_about_width(X_WG: np.ndarray) -> list[np.ndarray]:
+    """X_WG turned about its pads' width axis z_G through its grasp point by each of TURNS: the
+    pads still close across the same section of the part, from another side. In the air the
+    receiver may come from the sides the table closed to the robot (under a tool lying on it), and
+    a tool held horizontally is best squeezed from above and below: its weight's lever about a
+    vertical closing axis is nil."""
+    out = []
+    p_grasp = X_WG[:3, 3] + GRASP_DEPTH * X_WG[:3, 1]
+    for a in TURNS:
+        c, s_ = math.cos(a), math.sin(a)
+        R = X_WG[:3, :3] @ np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
+        X = np.eye(4)
+        X[:3, :3] = R
+        X[:3, 3] = p_grasp - GRASP_DEPTH * R[:, 1]
+        out.append(X)
+    return out
 
 
 # --- the receiver's motion ---------------------------------------------------------------------
@@ -335,23 +367,27 @@ def _duration(q_a: np.ndarray, q_b: np.ndarray, speed: float, minimum: float) ->
     return max(minimum, 1.875 * d / speed)
 
 
-def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_start: float
-                    ) -> HandoverMotion:
-    """From where it waits to its pre-grasp (from `t_start`, plan time), the straight approach,
-    closing, held to the end."""
+def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float,
+                    t_earliest: float = 0.0) -> HandoverMotion:
+    """From where it waits to its pre-grasp, there when the robot arrives at the hand-over pose
+    (`t_arrive`, plan time) if it can leave early enough (not before `t_earliest`: the object
+    lifted), the straight approach from then, closing, held to the end."""
     c = handover.config
     q_wait = mount_configuration(handover.X_WR_wait)
     X_pre = np.array(grasp.X_WR, float)
     X_pre[:3, 3] -= c.approach * X_pre[:3, 1]
     q_pre = mount_configuration(X_pre, near=q_wait)
     q_grasp = mount_configuration(grasp.X_WR, near=q_pre)
-    t_pre = t_start + _duration(q_wait, q_pre, c.speed, 1.0)
-    t_at = t_pre + max(0.5, 1.875 * c.approach / c.approach_speed)
+    move = _duration(q_wait, q_pre, c.speed, 1.0)
+    t_start = max(t_earliest, t_arrive - move)
+    t_pre = t_start + move
+    t_at = max(t_pre, t_arrive) + max(0.5, 1.875 * c.approach / c.approach_speed)
     t_zero = t_at + c.close_duration
     t_squeezed = t_zero + c.squeeze_duration
     t_closed = t_squeezed + c.settle_duration
     return HandoverMotion(
-        times=(0.0, t_start, t_pre, t_at), q=np.array([q_wait, q_wait, q_pre, q_grasp]),
+        times=(0.0, t_start, t_pre, max(t_pre, t_arrive), t_at),
+        q=np.array([q_wait, q_wait, q_pre, q_pre, q_grasp]),
         width_times=(0.0, t_at, t_zero, t_squeezed),
         widths=(WSG_MAX_OPENING, WSG_MAX_OPENING, 0.0, c.closed_width),
         t_closed=t_closed, X_WR_grasp=np.array(grasp.X_WR, float), part=grasp.part,

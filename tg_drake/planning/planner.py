@@ -960,7 +960,8 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
                   part, receiving=None):
     """The segments between the key configurations, assembled into a Plan: (Plan, "", True) or
     (None, reason, whether the pick motions were found). `receiving`: a pass's receiver motion
-    (`_receiving`: plan time of the arrival → HandoverMotion); the robot holds the object at the
+    (`_receiving`: plan times of the arrival and of the lift's end → HandoverMotion and the
+    receiver's hold duration); the robot holds the object at the
     hand-over pose until the receiver has closed, and the plan lasts until the receiver has held
     it alone for its `hold_duration`."""
     c = config
@@ -1028,7 +1029,7 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
     add_motion("descend")
     motion = None
     if receiving is not None:  # a pass: held until the receiver has closed
-        motion, hold_after = receiving(t)
+        motion, hold_after = receiving(t, t_lift_done)
         add_hold(q["place"], max(motion.t_closed - t, 0.0))
     t_open = t
     add_hold(q["place"], c.squeeze_duration + c.open_duration)
@@ -1069,4 +1070,5 @@ def _receiving(handover: Handover, candidates: GraspCandidates, target: ObjectDe
     if grasp is None:
         return None, why
     hold = handover.config.hold_duration
-    return (lambda t: (receiver_motion(handover, grasp, t_start=t), hold)), ""
+    return (lambda t, t_lifted: (receiver_motion(handover, grasp, t_arrive=t,
+                                                 t_earliest=t_lifted), hold)), ""
