@@ -258,7 +258,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     for name in ("wsg.state", "body_poses", "contact_results"):
         builder.Connect(station.outputs[name], supervisor.GetInputPort(name))
     if "receiver.state" in station.outputs:
-        builder.Connect(station.outputs["receiver.state"], supervisor.GetInputPort("receiver.state"))
+        builder.Connect(station.outputs["receiver.state"],
+                        supervisor.GetInputPort("receiver.state"))
     builder.Connect(supervisor.GetOutputPort("collisions"), logic.GetInputPort("collisions"))
     builder.Connect(supervisor.GetOutputPort("no_hold"), logic.GetInputPort("no_hold"))
     builder.Connect(supervisor.GetOutputPort("plan_request"), planner.GetInputPort("plan_request"))

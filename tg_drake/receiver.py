@@ -25,8 +25,14 @@ The station has a receiver when the scenario's task is pass or it gives a `recei
 from __future__ import annotations
 
 import numpy as np
+from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
-from pydrake.multibody.parsing import AddModel, ModelDirective, ModelDirectives, ProcessModelDirectives
+from pydrake.multibody.parsing import (
+    AddModel,
+    ModelDirective,
+    ModelDirectives,
+    ProcessModelDirectives,
+)
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import (
     JointActuatorIndex,
@@ -36,11 +42,12 @@ from pydrake.multibody.tree import (
     RevoluteJoint,
     SpatialInertia,
 )
-from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import MatrixGain
 
 from tg_drake.planning.handover import Handover, ReceiverConfig, mount_configuration
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS, WSG_MAX_OPENING, WSG_OPEN_POSITIONS
+from tg_drake.scenario import WsgPdDriver
 from tg_drake.systems.plan_messages import PlanState, PlanStatus
 
 RECEIVER = "receiver"  # its model instance's name
@@ -92,8 +99,6 @@ def add_receiver(plant: MultibodyPlant, parser, scenario) -> ModelInstanceIndex:
         actuator = plant.AddJointActuator(f"{RECEIVER}_{name}", joint, config.force_limit)
         actuator.set_controller_gains(gains)
     # The fingers as the robot's WSG.
-    from tg_drake.scenario import WsgPdDriver  # the scenario imports the planning cores
-
     driver = scenario.model_drivers.get("wsg")
     driver = driver if isinstance(driver, WsgPdDriver) else WsgPdDriver()
     for name in WSG_FINGER_JOINTS:
@@ -156,8 +161,6 @@ def connect_receiver(builder: DiagramBuilder, station) -> None:
 
 
 def _finger_state(builder, plant, instance):
-    from pydrake.systems.primitives import MatrixGain
-
     n_q, n_v = plant.num_positions(instance), plant.num_velocities(instance)
     S = np.zeros((4, n_q + n_v))
     for row, name in enumerate(WSG_FINGER_JOINTS):

@@ -456,7 +456,8 @@ class Supervisor(LeafSystem):
         plan, t_plan = memory.status.plan, memory.status.t_plan
         t = context.get_time() - t_plan
         pour = () if plan.t_pour is None else (plan.t_pour[1],)
-        handover = () if plan.t_handover is None else (plan.t_handover[1],)
+        t_handover = getattr(plan, "t_handover", None)  # plans without a hand-over may lack it
+        handover = () if t_handover is None else (t_handover[1],)
         key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, *handover, plan.duration)
         key_time = key_times[memory.checks_passed]
         if memory.t_released is not None and t < key_time:  # pass: the height while held

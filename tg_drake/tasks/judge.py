@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tg_drake.outcome import PLACE_XY_TOLERANCE
+from tg_drake.outcome import PLACE_XY_TOLERANCE, is_held
 from tg_drake.perception.ground_truth import pose_from_transform
 from tg_drake.tasks.contents import ContentsModel, count_contents
 from tg_drake.tasks.outcome import TaskOutcome
@@ -114,11 +114,9 @@ def judge_pass(*, receiver_left: bool, receiver_right: bool, receiver_opening: f
     more than closed on air: `tg_drake.outcome.is_held`), touches neither the robot's pads
     (`robot_touches`) nor the table (`on_table`), and its height, sampled from the release to
     now (`z_W` [m], world), stayed within `tolerance` [m]; `held_for` ≥ `hold_duration` [s]."""
-    from tg_drake.outcome import is_held  # the one rule for "held"
-
     z = np.asarray(z_W, float).ravel()
     drift = float(np.ptp(z)) if len(z) else float("inf")
-    held = is_held(receiver_left, receiver_right, receiver_opening)
+    held = is_held(receiver_left, receiver_right, receiver_opening)  # the one rule for "held"
     measure = {"receiver_held": held, "receiver_pads": [bool(receiver_left), bool(receiver_right)],
                "receiver_opening_m": round(float(receiver_opening), 4),
                "robot_touches": bool(robot_touches), "on_table": bool(on_table),
