@@ -75,8 +75,9 @@ class ReceiverConfig:
     approach: float = 0.1  # [m] its pre-grasp stands this far back along −y_R from its grasp
     max_approach_angle: float = 90.0  # [deg] its approach +y_R at most this far from its
     # direction (90: any approach from its side of the object, from above included)
-    speed: float = 0.5  # [m/s] moving to its pre-grasp (and [rad/s] turning), while the robot
-    # carries the object, so as to be there when it arrives
+    speed: float = 0.5  # [m/s] moving to its pre-grasp, while the robot carries the object, so
+    # as to be there when it arrives (peak: 1.875 × the mean) ...
+    turn_speed: float = 1.5  # [rad/s] ... and turning (each mount angle)
     approach_speed: float = 0.1  # [m/s] the straight approach (peak: 1.875 × the mean)
     close_duration: float = 0.8  # [s] open → 0 (then → closed_width over squeeze_duration), as
     # the robot's gripper closes (PlannerConfig)
@@ -105,6 +106,7 @@ class ReceiverConfig:
                   ("max_approach_angle", 0.0 < self.max_approach_angle <= 180.0,
                    "in (0, 180] deg"),
                   ("speed", self.speed > 0.0, "> 0 m/s"),
+                  ("turn_speed", self.turn_speed > 0.0, "> 0 rad/s"),
                   ("approach_speed", self.approach_speed > 0.0, "> 0 m/s"),
                   ("close_duration", self.close_duration > 0.0, "> 0 s"),
                   ("squeeze_duration", self.squeeze_duration >= 0.0, ">= 0 s"),
@@ -158,9 +160,17 @@ def mount_configuration(X_WR: np.ndarray, near=None) -> np.ndarray:
     else:  # the closing axis vertical: yaw and roll turn about the same axis
         yaw, roll = math.atan2(-R[0, 1], R[1, 1]), 0.0
     q = np.array([*np.asarray(X_WR, float)[:3, 3], yaw, pitch, roll])
-    if near is not None:
-        near = np.asarray(near, float)
-        q[3:] = near[3:] + (q[3:] - near[3:] + np.pi) % (2 * np.pi) - np.pi
+    if near is None:
+        return q
+    # Of the two angle triples of one rotation, (yaw, pitch, roll) and (yaw + π, π − pitch,
+    # roll + π), each unwrapped to within π of `near`'s, the nearer one.
+    near = np.asarray(near, float)
+    best = None
+    for angles in (q[3:], np.array([yaw + np.pi, np.pi - pitch, roll + np.pi])):
+        a = near[3:] + (angles - near[3:] + np.pi) % (2 * np.pi) - np.pi
+        if best is None or np.abs(a - near[3:]).max() < np.abs(best - near[3:]).max():
+            best = a
+    q[3:] = best
     return q
 
 
@@ -360,11 +370,13 @@ class HandoverMotion:
         return float(np.interp(t, self.width_times, self.widths))
 
 
-def _duration(q_a: np.ndarray, q_b: np.ndarray, speed: float, minimum: float) -> float:
+def _duration(q_a: np.ndarray, q_b: np.ndarray, speed: float, turn_speed: float,
+              minimum: float) -> float:
     """[s] a quintic move between two mount configurations, its peak speed (1.875 × the mean) at
-    most `speed` [m/s, rad/s]."""
-    d = float(max(np.linalg.norm(q_b[:3] - q_a[:3]), np.abs(q_b[3:] - q_a[3:]).max()))
-    return max(minimum, 1.875 * d / speed)
+    most `speed` [m/s] and `turn_speed` [rad/s]."""
+    d = max(float(np.linalg.norm(q_b[:3] - q_a[:3])) / speed,
+            float(np.abs(q_b[3:] - q_a[3:]).max()) / turn_speed)
+    return max(minimum, 1.875 * d)
 
 
 def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float,
@@ -378,7 +390,7 @@ def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float
     X_pre[:3, 3] -= c.approach * X_pre[:3, 1]
     q_pre = mount_configuration(X_pre, near=q_wait)
     q_grasp = mount_configuration(grasp.X_WR, near=q_pre)
-    move = _duration(q_wait, q_pre, c.speed, 1.0)
+    move = _duration(q_wait, q_pre, c.speed, c.turn_speed, 1.0)
     t_start = max(t_earliest, t_arrive - move)
     t_pre = t_start + move
     t_at = max(t_pre, t_arrive) + max(0.5, 1.875 * c.approach / c.approach_speed)
