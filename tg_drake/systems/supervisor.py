@@ -371,6 +371,12 @@ class Supervisor(LeafSystem):
             why = f"{status}" + (f" ({reason})" if reason else "")
             task_outcome = TaskOutcome(self._task, False, {},
                                        f"not done: the run ended {why}: {detail}")
+            # pass: a plan refused for its hand-over says so (the receiver's reach or grasp).
+            handover = next((r[r.index("hand-over:"):] for _, r in memory.failures
+                             if "hand-over:" in r), "")
+            if self._task == "pass" and handover:
+                task_outcome = TaskOutcome(self._task, False, {"handed_over": False},
+                                           f"not done: {handover}; the run ended {why}: {detail}")
         return dataclasses.replace(memory, phase=Phase.done, outcome=Outcome(
             status, reason, detail, reachable_parts=reachable,
             unreachable_parts=memory.collisions, requeries=memory.requeries,
