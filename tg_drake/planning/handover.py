@@ -75,6 +75,8 @@ class ReceiverConfig:
     approach: float = 0.1  # [m] its pre-grasp stands this far back along −y_R from its grasp
     max_approach_angle: float = 90.0  # [deg] its approach +y_R at most this far from its
     # direction (90: any approach from its side of the object, from above included)
+    max_grasps: int = 48  # of those, the best by P(part) · P(grasp | local shape) checked by the
+    # feasibility core per hand-over pose (each check ~10 ms of a 2-core machine's time)
     speed: float = 0.5  # [m/s] moving to its pre-grasp, while the robot carries the object, so
     # as to be there when it arrives (peak: 1.875 × the mean) ...
     turn_speed: float = 1.5  # [rad/s] ... and turning (each mount angle)
@@ -105,6 +107,7 @@ class ReceiverConfig:
                                                          ">= 0 m"),
                   ("max_approach_angle", 0.0 < self.max_approach_angle <= 180.0,
                    "in (0, 180] deg"),
+                  ("max_grasps", self.max_grasps >= 1, ">= 1"),
                   ("speed", self.speed > 0.0, "> 0 m/s"),
                   ("turn_speed", self.turn_speed > 0.0, "> 0 rad/s"),
                   ("approach_speed", self.approach_speed > 0.0, "> 0 m/s"),
@@ -219,14 +222,18 @@ class Handover:
 
 def robot_gripper_points(X_WG: np.ndarray, *, retreat: float, spacing: float = 0.005
                          ) -> np.ndarray:
-    """(N, 3) world points filling the robot's WSG at X_WG with its pads open (as they open at
-    the release) and swept `retreat` [m] back along −y_G (its retreat): what the receiver's
-    gripper must stay clear of, `spacing` [m] apart (about perception's voxel)."""
+    """(N, 3) world points on the surfaces of the robot's WSG at X_WG with its pads open (as
+    they open at the release) and swept `retreat` [m] back along −y_G (its retreat): what the
+    receiver's gripper must stay clear of, `spacing` [m] apart (about perception's voxel). (A box
+    of the receiver's that cuts one of these boxes contains some of its surface: the inside adds
+    nothing but cost.)"""
     out = []
     for _, centre, half in gripper_boxes(WSG_MAX_OPENING, retreat):
         axes = [np.linspace(c - h, c + h, max(2, int(np.ceil(2 * h / spacing)) + 1))
                 for c, h in zip(centre, half, strict=True)]
-        out.append(np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3))
+        grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+        on_face = np.any(np.isclose(np.abs(grid - centre), half, rtol=0, atol=1e-9), axis=1)
+        out.append(grid[on_face])
     p_G = np.concatenate(out)
     return p_G @ np.asarray(X_WG, float)[:3, :3].T + np.asarray(X_WG, float)[:3, 3]
 
@@ -249,12 +256,17 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
                           X_WO: np.ndarray, X_WO_handover: np.ndarray, X_WG_robot: np.ndarray,
                           receiver_parts: dict, handover: Handover, table_z: float,
                           retreat: float, feasibility: FeasibilityConfig | None = None,
-                          category: dict | None = None) -> tuple[ReceiverGrasp | None, str]:
+                          category: dict | None = None, cache: dict | None = None
+                          ) -> tuple[ReceiverGrasp | None, str]:
     """The receiver's best grasp at the hand-over (module doc), or (None, why there is none).
 
     `X_WO`: the object's perceived pose, where the candidates were made; `X_WO_handover`: its pose
     handed over; `X_WG_robot`: the robot's gripper there; `receiver_parts`: part → P(the receiver
-    takes it); `retreat` [m]: how far the robot backs out along −y_G after opening."""
+    takes it); `retreat` [m]: how far the robot backs out along −y_G after opening. `cache`: a
+    dict kept across the hand-over poses of one planning call: the feasibility of the receiver's
+    poses relative to the object and the robot's gripper does not change when the three are
+    turned together about the vertical (the planner's place yaws), so it is computed once per
+    robot grasp and set of poses."""
     config = handover.config
     feasibility = feasibility or FeasibilityConfig()
     parts = np.asarray(candidates.parts, int)
@@ -283,10 +295,21 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
         return None, (f"hand-over: the receiver cannot reach: its nearest grasp on {wanted} is "
                       f"{far[toward].min():.2f} m from where it waits (reach {config.reach} m)")
     keep = np.flatnonzero(toward & within)
-    target_p_W = (np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3])
-    robot = robot_gripper_points(X_WG_robot, retreat=retreat)
-    f = grasp_feasibility(X_WR[keep], target_p_W=target_p_W, others_p_W=robot, table_z=table_z,
-                          approach=config.approach, category=category, config=feasibility)
+    prior = p_recv[on_part[keep]] * np.asarray(candidates.p_local, float)[on_part[keep]]
+    keep = keep[np.argsort(-prior, kind="stable")[:config.max_grasps]]
+    X_OG = np.linalg.inv(np.asarray(X_WO_handover, float)) @ np.asarray(X_WG_robot, float)
+    key = (np.round(X_OG, 6).tobytes(), round(float(X_WO_handover[2, 3]) - table_z, 6),
+           keep.tobytes())
+    if cache is None or key not in cache:
+        target_p_W = (np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3])
+        robot = robot_gripper_points(X_WG_robot, retreat=retreat)
+        f = grasp_feasibility(X_WR[keep], target_p_W=target_p_W, others_p_W=robot,
+                              table_z=table_z, approach=config.approach, category=category,
+                              config=feasibility)
+        if cache is not None:
+            cache[key] = f
+    else:
+        f = cache[key]
     ok = np.array([not r for r in f.reasons], bool)
     if not ok.any():
         first = next((r for r in f.reasons if r), "")

@@ -307,6 +307,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
     seeds = _seeds(q_start, config.seed_postures, bearing)
 
     centroid = np.asarray(target.p_W, float).mean(axis=0) if len(target.p_W) else None
+    receiver_cache: dict = {}  # a pass: the receiver's feasibility per robot grasp
     tried: dict[str, set] = {name: set() for name in parts_order}
     plan = None
     for i in order:
@@ -352,7 +353,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             receiving = None
             if handover is not None:
                 receiving, why = _receiving(handover, candidates, target, part, X_WO,
-                                            X_WO_place_yawed, key, config, table_z, category)
+                                            X_WO_place_yawed, key, config, table_z, category,
+                                            receiver_cache)
                 if receiving is None:
                     costs[i], reasons[i] = np.inf, _farthest(reasons[i], why)
                     continue
@@ -1056,7 +1058,7 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
 
 def _receiving(handover: Handover, candidates: GraspCandidates, target: ObjectDescription,
                part: str, X_WO, X_WO_handover, key: _KeyPoses, config: PlannerConfig,
-               table_z: float, category):
+               table_z: float, category, cache: dict | None = None):
     """A pass's receiver for one hand-over pose: (plan time of the robot's arrival →
     (HandoverMotion, hold_duration), "") or (None, why): the receiver's grasp on the part the
     logic names for it, given the robot's `part` (tg_drake.logic.receive), chosen by the
@@ -1066,7 +1068,7 @@ def _receiving(handover: Handover, candidates: GraspCandidates, target: ObjectDe
     grasp, why = choose_receiver_grasp(
         candidates, target=target, X_WO=X_WO, X_WO_handover=X_WO_handover,
         X_WG_robot=key.X["place"].GetAsMatrix4(), receiver_parts=parts, handover=handover,
-        table_z=table_z, retreat=config.retreat_distance)
+        table_z=table_z, retreat=config.retreat_distance, cache=cache)
     if grasp is None:
         return None, why
     hold = handover.config.hold_duration
