@@ -227,8 +227,11 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
                     station.inputs["iiwa.desired_state"])
     builder.Connect(planner.GetOutputPort("wsg.position"), station.inputs["wsg.position"])
     if "receiver.mount" in station.inputs:  # a pass: the receiver follows the plan's hand-over
-        receiver = builder.AddNamedSystem("receiver_driver", ReceiverDriver(handover_of(scenario)))
+        receiver = builder.AddNamedSystem("receiver_driver", ReceiverDriver(
+            handover_of(scenario),
+            object_body=int(station.object_body(target_placement.instance_name).index())))
         builder.Connect(planner.GetOutputPort("plan_status"), receiver.GetInputPort("plan_status"))
+        builder.Connect(station.outputs["body_poses"], receiver.GetInputPort("body_poses"))
         for name in ("receiver.mount", "receiver.position"):
             builder.Connect(receiver.GetOutputPort(name), station.inputs[name])
         builder.Connect(logic.GetOutputPort("grasp_semantics"),

@@ -45,7 +45,12 @@ from pydrake.multibody.tree import (
 from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import MatrixGain
 
-from tg_drake.planning.handover import Handover, ReceiverConfig, mount_configuration
+from tg_drake.planning.handover import (
+    Handover,
+    ReceiverConfig,
+    mount_configuration,
+    mount_pose,
+)
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS, WSG_MAX_OPENING, WSG_OPEN_POSITIONS
 from tg_drake.scenario import WsgPdDriver
 from tg_drake.systems.plan_messages import PlanState, PlanStatus
@@ -193,18 +198,56 @@ class ReceiverDriver(LeafSystem):
         name: ReceiverDriver
         input_ports:
         - plan_status
+        - body_poses (optional)
         output_ports:
         - receiver.mount
         - receiver.position
+
+    The receiver stands for the person who takes the object, and like a person it sees where the
+    object is: with ``body_poses`` connected, every `period` seconds until its straight approach
+    begins (from the robot's arrival at the hand-over pose, `HandoverMotion.t_arrive`, for its
+    `look` seconds), it compares the object's simulated pose with where the plan carries it
+    (rigidly from where it stood, with the robot's gripper: `HandoverMotion.X_WG_robot` ·
+    `Plan.X_WG_grasp`⁻¹ · the pose at the plan's start) and moves its motion from then on with the
+    difference (an object that shifted in the robot's hand as the pads closed); then the
+    correction is kept. The robot's pipeline never sees it.
     """
 
-    def __init__(self, handover: Handover):
+    def __init__(self, handover: Handover, *, object_body: int | None = None,
+                 period: float = 0.05):
         super().__init__()
         self._q_wait = mount_configuration(handover.X_WR_wait)
+        self._object = object_body
         self._status = self.DeclareAbstractInputPort(
             "plan_status", AbstractValue.Make(PlanStatus(PlanState.planning)))
-        self.DeclareVectorOutputPort("receiver.mount", 12, self._calc_mount)
-        self.DeclareVectorOutputPort("receiver.position", 1, self._calc_width)
+        self._poses = self.DeclareAbstractInputPort(
+            "body_poses", AbstractValue.Make([RigidTransform()]))
+        # (X_WO at the plan's start or None, the correction C (4×4) applied to the motion)
+        self.DeclareAbstractState(AbstractValue.Make((None, np.eye(4))))  # the only state
+        self.DeclarePeriodicUnrestrictedUpdateEvent(period, 0.0, self._look)
+        on = {self.all_input_ports_ticket(), self.all_state_ticket(), self.time_ticket()}
+        self.DeclareVectorOutputPort("receiver.mount", 12, self._calc_mount,
+                                     prerequisites_of_calc=on)
+        self.DeclareVectorOutputPort("receiver.position", 1, self._calc_width,
+                                     prerequisites_of_calc=on)
+
+    def _look(self, context, state):
+        if self._object is None or not self._poses.HasValue(context):
+            return
+        motion, t = self._motion(context)
+        X_start, C = context.get_abstract_state(0).get_value()
+        if motion is None or t >= motion.times[3]:  # no plan yet, or approaching: keep
+            return
+        if X_start is not None and t < motion.t_arrive:  # carrying: nothing to compare yet
+            return
+        X_WO = self._poses.Eval(context)[self._object].GetAsMatrix4()
+        plan = self._status.Eval(context).plan
+        if X_start is None:  # standing where perception saw it
+            state.get_mutable_abstract_state(0).set_value((X_WO, C))
+            return
+        expected = motion.X_WG_robot @ np.linalg.inv(np.asarray(plan.X_WG_grasp)) @ X_start
+        C = X_WO @ np.linalg.inv(expected)
+        state.get_mutable_abstract_state(0).set_value((X_start, C))
 
     def _motion(self, context):
         status: PlanStatus = self._status.Eval(context)
@@ -219,7 +262,11 @@ class ReceiverDriver(LeafSystem):
         if motion is None:
             output.SetFromVector(np.concatenate([self._q_wait, np.zeros(6)]))
             return
-        output.SetFromVector(np.concatenate([motion.configuration(t), motion.velocity(t)]))
+        q, v = motion.configuration(t), motion.velocity(t)
+        C = context.get_abstract_state(0).get_value()[1]
+        if t >= motion.t_arrive and not np.allclose(C, np.eye(4)):  # at the hand-over
+            q = mount_configuration(C @ mount_pose(q), near=q)
+        output.SetFromVector(np.concatenate([q, v]))
 
     def _calc_width(self, context, output: BasicVector):
         motion, t = self._motion(context)

@@ -140,7 +140,8 @@ def test_the_receivers_motion_reaches_its_grasp_then_closes():
     assert np.allclose(motion.velocity(5.0), 0.0)
     assert np.allclose(mount_pose(motion.configuration(motion.times[-1] + 1)), grasp.X_WR)
     t_pre = motion.times[2]
-    assert motion.times[1] > 5.0 and t_pre == pytest.approx(20.0) and motion.times[3] == 20.0
+    assert motion.times[1] > 5.0 and t_pre == pytest.approx(20.0) and motion.t_arrive == 20.0
+    assert motion.times[3] == pytest.approx(20.0 + HANDOVER.config.look)
     X_pre = mount_pose(motion.configuration(t_pre))
     assert np.allclose(X_pre[:3, 3], grasp.X_WR[:3, 3] - 0.1 * grasp.X_WR[:3, 1])
     assert motion.width(t_pre) == pytest.approx(0.11)

@@ -81,6 +81,8 @@ class ReceiverConfig:
     # as to be there when it arrives (peak: 1.875 × the mean) ...
     turn_speed: float = 1.5  # [rad/s] ... and turning (each mount angle)
     approach_speed: float = 0.1  # [m/s] the straight approach (peak: 1.875 × the mean)
+    look: float = 0.3  # [s] at its pre-grasp after the robot has arrived, before approaching:
+    # where the object is in the robot's hand is seen then (tg_drake.receiver.ReceiverDriver)
     close_duration: float = 0.8  # [s] open → 0 (then → closed_width over squeeze_duration), as
     # the robot's gripper closes (PlannerConfig)
     squeeze_duration: float = 0.1  # [s]
@@ -108,6 +110,7 @@ class ReceiverConfig:
                   ("max_approach_angle", 0.0 < self.max_approach_angle <= 180.0,
                    "in (0, 180] deg"),
                   ("max_grasps", self.max_grasps >= 1, ">= 1"),
+                  ("look", self.look >= 0.0, ">= 0 s"),
                   ("speed", self.speed > 0.0, "> 0 m/s"),
                   ("turn_speed", self.turn_speed > 0.0, "> 0 rad/s"),
                   ("approach_speed", self.approach_speed > 0.0, "> 0 m/s"),
@@ -364,6 +367,8 @@ class HandoverMotion:
     X_WR_grasp: np.ndarray  # 4×4 its grasp pose
     part: str = ""  # the part it takes
     hold_duration: float = PASS_HOLD_DURATION  # [s] it must hold it alone after the release
+    X_WG_robot: np.ndarray | None = None  # 4×4 the robot's gripper at the hand-over pose
+    t_arrive: float = 0.0  # [s] the robot has arrived there
 
     def _segment(self, t: float):
         times = self.times
@@ -403,10 +408,11 @@ def _duration(q_a: np.ndarray, q_b: np.ndarray, speed: float, turn_speed: float,
 
 
 def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float,
-                    t_earliest: float = 0.0) -> HandoverMotion:
+                    t_earliest: float = 0.0, X_WG_robot: np.ndarray | None = None
+                    ) -> HandoverMotion:
     """From where it waits to its pre-grasp, there when the robot arrives at the hand-over pose
     (`t_arrive`, plan time) if it can leave early enough (not before `t_earliest`: the object
-    lifted), the straight approach from then, closing, held to the end."""
+    lifted), held there `look` seconds more, the straight approach, closing, held to the end."""
     c = handover.config
     q_wait = mount_configuration(handover.X_WR_wait)
     X_pre = np.array(grasp.X_WR, float)
@@ -416,14 +422,17 @@ def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float
     move = _duration(q_wait, q_pre, c.speed, c.turn_speed, 1.0)
     t_start = max(t_earliest, t_arrive - move)
     t_pre = t_start + move
-    t_at = max(t_pre, t_arrive) + max(0.5, 1.875 * c.approach / c.approach_speed)
+    t_look = max(t_pre, t_arrive) + c.look
+    t_at = t_look + max(0.5, 1.875 * c.approach / c.approach_speed)
     t_zero = t_at + c.close_duration
     t_squeezed = t_zero + c.squeeze_duration
     t_closed = t_squeezed + c.settle_duration
     return HandoverMotion(
-        times=(0.0, t_start, t_pre, max(t_pre, t_arrive), t_at),
+        times=(0.0, t_start, t_pre, t_look, t_at),
         q=np.array([q_wait, q_wait, q_pre, q_pre, q_grasp]),
         width_times=(0.0, t_at, t_zero, t_squeezed),
         widths=(WSG_MAX_OPENING, WSG_MAX_OPENING, 0.0, c.closed_width),
         t_closed=t_closed, X_WR_grasp=np.array(grasp.X_WR, float), part=grasp.part,
-        hold_duration=c.hold_duration)
+        hold_duration=c.hold_duration,
+        X_WG_robot=None if X_WG_robot is None else np.asarray(X_WG_robot, float),
+        t_arrive=float(t_arrive))

@@ -1072,5 +1072,7 @@ def _receiving(handover: Handover, candidates: GraspCandidates, target: ObjectDe
     if grasp is None:
         return None, why
     hold = handover.config.hold_duration
+    X_WG_place = key.X["place"].GetAsMatrix4()
     return (lambda t, t_lifted: (receiver_motion(handover, grasp, t_arrive=t,
-                                                 t_earliest=t_lifted), hold)), ""
+                                                 t_earliest=t_lifted, X_WG_robot=X_WG_place),
+                                 hold)), ""
