@@ -161,6 +161,10 @@ def test_the_logic_names_the_handle_of_a_tool_for_the_receiver():
     assert list(parts) == ["handle", "usable_area"] and parts["handle"] == pytest.approx(0.9)
     held = receiver_parts({"knife": 1.0}, held="handle", parts=("handle", "usable_area"))
     assert held == pytest.approx({"handle": 0.7, "usable_area": 0.3})
+    # Category probabilities whose rounding would sum above 1 are accepted.
+    near = receiver_parts({"knife": 0.5000005, "hammer": 0.4999995}, held="usable_area",
+                          parts=("handle", "usable_area"))
+    assert near["handle"] == pytest.approx(0.9)
     # A cup held by its middle is taken by its middle's other side first.
     cup = receiver_parts({"cup": 1.0}, held="middle", parts=("top", "middle", "bottom"))
     assert max(cup, key=cup.get) == "middle" and sum(cup.values()) == pytest.approx(1.0)

@@ -13,6 +13,7 @@ object shows (`parts`) and normalised; {} when the theory names none of them.
 from __future__ import annotations
 
 import functools
+import math
 
 from problog import get_evaluatable
 from problog.program import PrologString
@@ -55,7 +56,8 @@ def receiver_parts(category: dict[str, float] | None, *, held: str,
     total = sum(weights.values())
     if total <= 0:
         weights, total = {c: 1.0 for c in CATEGORIES}, float(len(CATEGORIES))
-    key = tuple((c, round(w / total, ROUND)) for c, w in weights.items())
+    # Rounded down, so that the annotated disjunction's weights never sum above 1.
+    key = tuple((c, math.floor(w / total * 10**ROUND) / 10**ROUND) for c, w in weights.items())
     answer = _receive(key, held)
     kept = {p: answer.get(p, 0.0) for p in parts if answer.get(p, 0.0) > 0}
     norm = sum(kept.values())
