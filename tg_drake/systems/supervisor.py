@@ -574,7 +574,8 @@ class Supervisor(LeafSystem):
                           robot_touches=hand.left or hand.right,
                           on_table=touches_table(contacts, geometries=self._model.geometries),
                           z_W=np.array(z), held_for=context.get_time() - memory.t_released,
-                          hold_duration=memory.status.plan.handover.hold_duration)
+                          hold_duration=memory.status.plan.handover.hold_duration,
+                          receiver_part=memory.status.plan.handover.part)
 
     # Outputs.
     def _memory_of(self, context) -> _Memory:

@@ -108,12 +108,13 @@ PASS_HOLD_DURATION = 1.0  # [s] the receiver must hold it alone this long after 
 def judge_pass(*, receiver_left: bool, receiver_right: bool, receiver_opening: float,
                robot_touches: bool, on_table: bool, z_W, held_for: float,
                hold_duration: float = PASS_HOLD_DURATION,
-               tolerance: float = PASS_HEIGHT_TOLERANCE) -> TaskOutcome:
+               tolerance: float = PASS_HEIGHT_TOLERANCE, receiver_part: str = "") -> TaskOutcome:
     """pass: `held_for` [s] after the robot let go, the object touches both of the receiver's
     pads (`receiver_left`, `receiver_right`; the receiver's fingers `receiver_opening` [m] apart,
     more than closed on air: `tg_drake.outcome.is_held`), touches neither the robot's pads
     (`robot_touches`) nor the table (`on_table`), and its height, sampled from the release to
-    now (`z_W` [m], world), stayed within `tolerance` [m]; `held_for` ≥ `hold_duration` [s]."""
+    now (`z_W` [m], world), stayed within `tolerance` [m]; `held_for` ≥ `hold_duration` [s].
+    `receiver_part`: the part the receiver took (reported)."""
     z = np.asarray(z_W, float).ravel()
     drift = float(np.ptp(z)) if len(z) else float("inf")
     held = is_held(receiver_left, receiver_right, receiver_opening)  # the one rule for "held"
@@ -121,7 +122,7 @@ def judge_pass(*, receiver_left: bool, receiver_right: bool, receiver_opening: f
                "receiver_opening_m": round(float(receiver_opening), 4),
                "robot_touches": bool(robot_touches), "on_table": bool(on_table),
                "height_change_m": round(drift, 4) if np.isfinite(drift) else None,
-               "held_for_s": round(float(held_for), 3)}
+               "held_for_s": round(float(held_for), 3), "receiver_part": receiver_part}
     if not held:
         pads = [n for n, t in (("left", receiver_left), ("right", receiver_right)) if not t]
         why = (f"its {' and '.join(pads)} pad{'s' if len(pads) > 1 else ''} not touching"
