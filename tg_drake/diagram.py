@@ -23,6 +23,9 @@ Wiring (docs/design.md, "The diagram"):
         wsg.position, plan_status
     scene_description, grasp_semantics, ranked_grasps, plan_status, wsg.state, body_poses,
         contact_results ─▶ supervisor ─▶ collisions (─▶ logic), plan_request (─▶ planner), outcome
+    a pass (tg_drake.receiver): grasp_semantics ─▶ planner (the receiver's part); plan_status,
+        body_poses ─▶ receiver_driver ─▶ receiver.mount, receiver.position; receiver.state ─▶
+        supervisor
 
 The supervisor closes the loop (unreachable parts become collision evidence, the logic's veto is
 checked after every re-query) and judges the execution: simulate until
