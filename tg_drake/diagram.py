@@ -24,6 +24,9 @@ Wiring (docs/design.md, "The diagram"):
         wsg.position, plan_status
     scene_description, grasp_semantics, ranked_grasps, plan_status, wsg.state, body_poses,
         contact_results ─▶ supervisor ─▶ collisions (─▶ logic), plan_request (─▶ planner), outcome
+    a pass (tg_drake.receiver): grasp_semantics ─▶ planner (the receiver's part); plan_status,
+        body_poses ─▶ receiver_driver ─▶ receiver.mount, receiver.position; receiver.state ─▶
+        supervisor
 
 The supervisor closes the loop (unreachable parts become collision evidence, the logic's veto is
 checked after every re-query) and judges the execution: simulate until
@@ -43,6 +46,7 @@ from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.grasping.model import load_model
 from tg_drake.objects import box_centre, get_object
 from tg_drake.planning.task_motion import dispenser_obstacle, surfaces_in_world, task_placing
+from tg_drake.receiver import ReceiverDriver, handover_of
 from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario, place_surface
 from tg_drake.station import DISPENSER_WALL, Station, add_station, dispenser_frame, placement_pose
 from tg_drake.systems.depth_noise import DepthNoise
@@ -220,13 +224,24 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
                            config=config.tasks)
     planner = builder.AddNamedSystem("planner", GraspPlanner(
         place_xy=place_xy_W, start_time=supervision.planning_start + supervision.period,
-        config=config.planner, scenario=scenario, placing=placing, surfaces=surfaces))
+        config=config.planner, scenario=scenario, placing=placing, surfaces=surfaces,
+        handover=handover_of(scenario)))
     builder.Connect(scene, planner.GetInputPort("scene_description"))
     builder.Connect(ranked, planner.GetInputPort("ranked_grasps"))
     builder.Connect(station.outputs["iiwa.state"], planner.GetInputPort("iiwa.state"))
     builder.Connect(planner.GetOutputPort("iiwa.desired_state"),
                     station.inputs["iiwa.desired_state"])
     builder.Connect(planner.GetOutputPort("wsg.position"), station.inputs["wsg.position"])
+    if "receiver.mount" in station.inputs:  # a pass: the receiver follows the plan's hand-over
+        receiver = builder.AddNamedSystem("receiver_driver", ReceiverDriver(
+            handover_of(scenario),
+            object_body=int(station.object_body(target_placement.instance_name).index())))
+        builder.Connect(planner.GetOutputPort("plan_status"), receiver.GetInputPort("plan_status"))
+        builder.Connect(station.outputs["body_poses"], receiver.GetInputPort("body_poses"))
+        for name in ("receiver.mount", "receiver.position"):
+            builder.Connect(receiver.GetOutputPort(name), station.inputs[name])
+        builder.Connect(logic.GetOutputPort("grasp_semantics"),
+                        planner.GetInputPort("grasp_semantics"))
 
     plant = station.plant
     supervisor = builder.AddNamedSystem("supervisor", Supervisor(
@@ -235,7 +250,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
             wsg_instance=station.instances["wsg"], table_instance=station.instances["table"],
             p_OC=box_centre(target_placement.id), X_WT=X_WT.GetAsMatrix4(),
             is_tool=get_object(target_placement.id).is_tool,
-            surfaces=[(s.name, surface_body_name(s.name)) for s in scenario.surfaces]),
+            surfaces=[(s.name, surface_body_name(s.name)) for s in scenario.surfaces],
+            receiver_instance=station.instances.get("receiver")),
         task=scenario.task.task, place_on=surface.name if surface is not None else "",
         pour_into=scenario.task.pour_into, container=target_placement.instance_name,
         count_contents=_contents_counter(scenario, station, target_placement),
@@ -250,6 +266,9 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     builder.Connect(planner.GetOutputPort("plan_status"), supervisor.GetInputPort("plan_status"))
     for name in ("wsg.state", "body_poses", "contact_results"):
         builder.Connect(station.outputs[name], supervisor.GetInputPort(name))
+    if "receiver.state" in station.outputs:
+        builder.Connect(station.outputs["receiver.state"],
+                        supervisor.GetInputPort("receiver.state"))
     builder.Connect(supervisor.GetOutputPort("collisions"), logic.GetInputPort("collisions"))
     builder.Connect(supervisor.GetOutputPort("no_hold"), logic.GetInputPort("no_hold"))
     builder.Connect(supervisor.GetOutputPort("plan_request"), planner.GetInputPort("plan_request"))

@@ -43,6 +43,7 @@ from tg_drake.models import models_root
 from tg_drake.objects import PACKAGE, add_library, get_object, mesh, register_object
 from tg_drake.perception.config import PerceptionConfig
 from tg_drake.perception.sensor_model import IdealDepth, SensorModel, StructuredLight
+from tg_drake.planning.handover import ReceiverConfig
 from tg_drake.planning.planner import PlannerConfig
 from tg_drake.planning.task_motion import TaskMotionConfig
 from tg_drake.robot import WSG_FORCE_LIMIT, X_7G_RPY, X_7G_XYZ
@@ -408,6 +409,8 @@ class Scenario:
     # (pourIn); tg_drake.tasks.contents.
     contents: ContentsConfig = field(default_factory=ContentsConfig)
     dispenser: DispenserConfig | None = None
+    receiver: ReceiverConfig | None = None  # pass: the second gripper that takes the object
+    # (tg_drake.planning.handover; table frame); None: the default one when the task is pass
 
     def target_placement(self) -> ObjectPlacement:
         if not self.objects:
@@ -598,6 +601,8 @@ def validate(scenario: Scenario, *, where: str = "<scenario>",
         _validate_geometry(scenario)
         _validate_surfaces(scenario)
         _validate_contents(scenario)
+        if scenario.receiver is not None:
+            scenario.receiver.validate("receiver")
     except ScenarioError as e:
         raise ScenarioError(e.message, file=where, field=e.field) from None
 

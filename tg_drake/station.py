@@ -25,8 +25,10 @@ The spheres and the dispenser are drawn in Meshcat but not seen by the cameras.
 Station ports (as exported by `make_station`; `add_station` returns the same ports by name):
 
 - inputs: ``iiwa.desired_state`` (14: q, v), ``wsg.position`` (1: opening width [m]), and with a
-  `dispenser` ``dispenser.open`` (1: > 0.5 opens its gate).
-- outputs: ``iiwa.state`` (14), ``wsg.state`` (4), ``body_poses``, ``contact_results``,
+  `dispenser` ``dispenser.open`` (1: > 0.5 opens its gate); with a receiver (a pass,
+  tg_drake.receiver) ``receiver.mount`` (12) and ``receiver.position`` (1).
+- outputs: ``iiwa.state`` (14), ``wsg.state`` (4), with a receiver ``receiver.state`` (4),
+  ``body_poses``, ``contact_results``,
   ``query_object``, and per camera ``<camera>.rgb_image``, ``<camera>.depth_image``,
   ``<camera>.label_image``, ``<camera>.camera_pose`` (X_WC, a RigidTransform).
 """
@@ -84,6 +86,7 @@ from pydrake.systems.sensors import ApplyCameraConfig, CameraConfig, CameraInfo,
 from tg_drake.errors import ModelError, ScenarioError, unknown_name
 from tg_drake.models import make_parser
 from tg_drake.objects import get_object, mesh
+from tg_drake.receiver import RECEIVER, add_receiver, connect_receiver, receiver_of
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
 from tg_drake.robot_plants import add_scenario_models
 from tg_drake.scenario import (
@@ -397,6 +400,8 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
     if scenario.dispenser is not None:
         dispensed, _ = _add_dispenser(plant, scenario, contents_visible)
         contents.append(dispensed)
+    if receiver_of(scenario) is not None:  # a pass: the second WSG (tg_drake.receiver)
+        instances[RECEIVER] = add_receiver(plant, parser, scenario)
 
     # Drivers: PD control on the joint actuators (desired state enters the plant).
     for name, driver in scenario.model_drivers.items():
@@ -425,6 +430,8 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
         builder.Connect(command.get_output_port(), plant.get_desired_state_input_port(
             plant.GetModelInstanceByName("dispenser")))
         station.inputs["dispenser.open"] = command.get_input_port()
+    if RECEIVER in instances:
+        connect_receiver(builder, station)
 
     # Ports of the arm and the gripper.
     if "iiwa" in instances:

@@ -64,8 +64,11 @@ def test_default_scenario_passes_the_cup_by_its_middle(cached_run):
     assert max(result["category"], key=result["category"].get) == "cup"
     assert max(result["part"], key=result["part"].get) == "middle"
     assert result["grasp"]["part"] == "middle"
-    assert result["outcome"]["status"] == "placed", result["outcome"]
-    assert "cup" in summary(result) and "placed" in summary(result)
+    # A pass: handed over to the receiver, which holds it alone (the robot's outcome: lifted).
+    assert result["outcome"]["status"] == "lifted", result["outcome"]
+    assert result["outcome"]["detail"].startswith("handed over"), result["outcome"]
+    assert result["task_outcome"]["success"], result["task_outcome"]
+    assert "cup" in summary(result) and "handed over" in summary(result)
     # P(hold) is reported beside the score, not as its factor, while the stage does not rank by it.
     assert not result["config"]["pipeline"]["feasibility"]["rank_by_hold"]
     grasp_line = next(line for line in summary(result).splitlines() if line.startswith("grasp"))

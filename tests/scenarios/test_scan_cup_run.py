@@ -16,9 +16,11 @@ objects:
   - {mesh: meshes/scan_cup.obj, category: cup, units: auto, up_axis: y, pose: upright,
      xy: [0.0, 0.0], yaw: 0, name: scan_cup}
 task:
-  task: pass
+  task: p&pInUpright
   place_xy: [0.0, -0.3]
 """
+# (p&pInUpright of an upright cup is the pick-and-place the default scenario's pass was before
+# the pass handed the object over to a receiver: what this test checks is the mesh's way in.)
 
 
 @pytest.fixture(scope="module")

@@ -7,12 +7,15 @@ from pathlib import Path
 
 import pytest
 
+from tg_drake.run import run_scenario
+from tg_drake.scenario import load_scenario
+
 TASKS = Path(__file__).resolve().parents[2] / "scenarios" / "tasks"
 
 
 def test_every_task_scenario_is_a_case():
     cases = {"can_on_shelf", "can_sideways", "can_upsidedown", "glass_upright", "mug_pour_out",
-             "glass_pour_in"}
+             "glass_pour_in", "knife_pass", "mug_pass"}
     assert {p.stem for p in TASKS.glob("*.yaml")} >= cases
 
 
@@ -73,3 +76,44 @@ def test_where_the_reach_forbids_turning_it_in_the_hand_the_failure_says_so(cach
     assert "turned to rest upright in the hand" in result["outcome"]["detail"]
     assert "place-and-regrasp is not implemented" in result["outcome"]["detail"]
     assert not result["task_outcome"]["success"]
+
+
+def passed_over(result: dict) -> dict:
+    """The pass's task outcome, checked for the receiver's hold: both its pads on the object, the
+    robot's and the table's off it, its height steady, for the receiver's hold duration."""
+    task = result["task_outcome"]
+    assert task["task"] == "pass"
+    assert task["success"], (task, result["outcome"])
+    m = task["measure"]
+    assert m["receiver_held"] and m["receiver_pads"] == [True, True]
+    assert not m["robot_touches"] and not m["on_table"]
+    assert m["height_change_m"] <= 0.01 and m["held_for_s"] >= 1.0
+    # The robot's own part of a pass: grasped, lifted and let go in the air, not placed.
+    assert (result["outcome"]["status"], result["outcome"]["reason"]) == ("lifted", "")
+    assert result["outcome"]["detail"].startswith("handed over")
+    return task
+
+
+@pytest.mark.slow
+def test_a_mug_is_handed_over_to_the_receiver(cached_run):
+    passed_over(cached_run(TASKS / "mug_pass.yaml", None))
+
+
+@pytest.mark.slow
+def test_a_knife_is_handed_over_to_the_receiver(cached_run):
+    passed_over(cached_run(TASKS / "knife_pass.yaml", None))
+
+
+def test_a_receiver_that_cannot_reach_fails_the_pass_saying_so():
+    # The default cup, its receiver's mount reaching only 0.1 m from where it waits: no plan is
+    # made (the receiver's grasp is checked before any inverse kinematics), nothing is simulated
+    # past planning.
+    scenario = load_scenario(TASKS.parent / "default.yaml")
+    scenario.receiver = load_scenario(TASKS / "mug_pass.yaml").receiver
+    scenario.receiver.reach = 0.1
+    result = run_scenario(scenario, scenario_path="receiver out of reach")
+    assert (result["outcome"]["status"], result["outcome"]["reason"]) == ("failed", "unreachable")
+    task = result["task_outcome"]
+    assert task["task"] == "pass" and not task["success"]
+    assert "hand-over: the receiver cannot reach" in task["detail"], task
+    assert "(reach 0.1 m)" in task["detail"]

@@ -50,6 +50,8 @@ from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.grasping.feasibility import GRASP_DEPTH  # [m] the grasp point along +y_G
+from tg_drake.logic.receive import receiver_parts
+from tg_drake.planning.handover import Handover, choose_receiver_grasp, receiver_motion
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.task_motion import (
     TaskPlacing,
@@ -164,6 +166,10 @@ class Plan:
     # beyond a turn about the vertical (a task's resting pose); None: its orientation is kept
     t_pour: tuple | None = None  # [s] (start, end) of holding the container tilted over the
     # bowl (pourOut) or under the dispenser (pourIn); None when the plan pours nothing
+    t_handover: tuple | None = None  # [s] (receiver closes, robot released) of a pass; None:
+    # no hand-over
+    handover: object | None = None  # pass: the receiver's motion (planning.handover.
+    # HandoverMotion, its grasp and part), in plan time; None: no hand-over
 
     def q(self, t: float) -> np.ndarray:
         """(7,) joint positions at plan time t (held at the ends outside [0, duration])."""
@@ -225,7 +231,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                         obstacles=(), place_xy, q_start=IIWA_HOME, table_z: float = 0.0,
                         config: PlannerConfig | None = None, scenario=None,
                         exclude_parts=(), max_parts: int | None = None,
-                        placing: TaskPlacing | None = None, surfaces=()) -> PlanResult:
+                        placing: TaskPlacing | None = None, surfaces=(),
+                        handover: Handover | None = None,
+                        category: dict | None = None) -> PlanResult:
     """The first candidate (by score) with a full collision-free pick-and-place plan.
 
     Args:
@@ -242,6 +250,10 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             pose to turn the object into, a surface to put it on); None places it at `place_xy`
             on the table, its orientation kept.
         surfaces: `Surface` boxes standing on the table, obstacles of every motion.
+        handover: a pass (tg_drake.planning.handover): the object goes to the hand-over point
+            in the air (its orientation kept, turned about the vertical by `place_yaws`), the
+            receiver takes it by the part the logic names for it (`category`: the logic's
+            category distribution), then the robot opens and retreats.
     """
     config = config or PlannerConfig()
     t_start = time.perf_counter()
@@ -295,6 +307,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
     seeds = _seeds(q_start, config.seed_postures, bearing)
 
     centroid = np.asarray(target.p_W, float).mean(axis=0) if len(target.p_W) else None
+    receiver_cache: dict = {}  # a pass: the receiver's feasibility per robot grasp
     tried: dict[str, set] = {name: set() for name in parts_order}
     plan = None
     for i in order:
@@ -313,6 +326,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         found = False
         places = _task_place_variants(X_WO_place, config, placing=placing, X_WO=X_WO,
                                       X_WG=X_WG, extents=target.extents, is_tool=target.is_tool)
+        if handover is not None:  # a pass: handed over in the air (planning.handover)
+            places = [(None, X) for X in _place_variants(handover.object_pose(X_WO), config)]
         if not places:
             costs[i] = np.inf
             reasons[i] = _farthest(reasons[i], f"place pose: {target_name(target)} cannot "
@@ -335,6 +350,14 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 reasons[i] = _farthest(reasons[i],
                                        f"{below[0]} pose puts the gripper under the table")
                 break
+            receiving = None
+            if handover is not None:
+                receiving, why = _receiving(handover, candidates, target, part, X_WO,
+                                            X_WO_place_yawed, key, config, table_z, category,
+                                            receiver_cache)
+                if receiving is None:
+                    costs[i], reasons[i] = np.inf, _farthest(reasons[i], why)
+                    continue
             poses, failure = _waypoint_configurations(arms, key, seeds, config)
             if "pre-grasp" in poses:
                 part_reachable[part] = True
@@ -353,7 +376,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                     continue
                 break
             plan, failure, picked = _trajectories(arms, q_start, poses, key, config, seeds,
-                                                  candidate=int(i), part=part)
+                                                  candidate=int(i), part=part,
+                                                  receiving=receiving)
             part_pickable[part] |= picked
             if plan is None and R_turn is not None and failure.startswith(PLACE_FAILURES):
                 failure += (f", the object turned to rest {placing.pose} in the hand "
@@ -935,9 +959,13 @@ def _pour_moves(carry: ArmPlant, c: PlannerConfig, *, tilt: bool) -> list[tuple]
 
 
 def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *, candidate,
-                  part):
+                  part, receiving=None):
     """The segments between the key configurations, assembled into a Plan: (Plan, "", True) or
-    (None, reason, whether the pick motions were found)."""
+    (None, reason, whether the pick motions were found). `receiving`: a pass's receiver motion
+    (`_receiving`: plan times of the arrival and of the lift's end → HandoverMotion and the
+    receiver's hold duration); the robot holds the object at the
+    hand-over pose until the receiver has closed, and the plan lasts until the receiver has held
+    it alone for its `hold_duration`."""
     c = config
     carry = arms.carry(key.X_GO)
     # name, from, to, plant, clearance, limits, straight line or None (free: via-point guesses)
@@ -1001,10 +1029,16 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
         add_hold(q["pour"], key.pour_hold)
         add_motion("return")
     add_motion("descend")
+    motion = None
+    if receiving is not None:  # a pass: held until the receiver has closed
+        motion, hold_after = receiving(t, t_lift_done)
+        add_hold(q["place"], max(motion.t_closed - t, 0.0))
     t_open = t
     add_hold(q["place"], c.squeeze_duration + c.open_duration)
     t_place_done = t
     add_motion("retreat")
+    if motion is not None and t < t_place_done + hold_after:
+        add_hold(q["retreat"], t_place_done + hold_after - t)
     q_traj = CompositeTrajectory(pieces)
     width_traj = PiecewisePolynomial.FirstOrderHold(
         [0.0, t_close, t_close + c.close_duration, t_close + c.close_duration + c.squeeze_duration,
@@ -1016,5 +1050,29 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
                 t_place_done=t_place_done, duration=t, candidate=candidate, part=part,
                 X_WG_grasp=key.X["grasp"].GetAsMatrix4(),
                 X_WO_place=key.X_WO_place, waypoints=q, segments=tuple(rows),
-                R_turn=key.R_turn, t_pour=t_pour)
+                R_turn=key.R_turn, t_pour=t_pour,
+                t_handover=None if motion is None else (motion.t_closed, t_place_done),
+                handover=motion)
     return plan, "", True
+
+
+def _receiving(handover: Handover, candidates: GraspCandidates, target: ObjectDescription,
+               part: str, X_WO, X_WO_handover, key: _KeyPoses, config: PlannerConfig,
+               table_z: float, category, cache: dict | None = None):
+    """A pass's receiver for one hand-over pose: (plan time of the robot's arrival →
+    (HandoverMotion, hold_duration), "") or (None, why): the receiver's grasp on the part the
+    logic names for it, given the robot's `part` (tg_drake.logic.receive), chosen by the
+    feasibility core clear of the robot's gripper and the table (planning.handover)."""
+    shown = tuple(PART_LABELS[k] for k in np.unique(np.asarray(candidates.parts, int)))
+    parts = receiver_parts(category, held=part, parts=shown)
+    grasp, why = choose_receiver_grasp(
+        candidates, target=target, X_WO=X_WO, X_WO_handover=X_WO_handover,
+        X_WG_robot=key.X["place"].GetAsMatrix4(), receiver_parts=parts, handover=handover,
+        table_z=table_z, retreat=config.retreat_distance, cache=cache)
+    if grasp is None:
+        return None, why
+    hold = handover.config.hold_duration
+    X_WG_place = key.X["place"].GetAsMatrix4()
+    return (lambda t, t_lifted: (receiver_motion(handover, grasp, t_arrive=t,
+                                                 t_earliest=t_lifted, X_WG_robot=X_WG_place),
+                                 hold)), ""

@@ -22,7 +22,7 @@ from tg_drake.planning.task_motion import TaskPlacing
 from tg_drake.robot import IIWA_HOME
 from tg_drake.scenario import Scenario
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
-from tg_drake.types import GraspCandidates, SceneDescription
+from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 # Without a connected ``plan_request`` the planner makes one attempt with no exclusions.
 _ONE_ATTEMPT = PlanRequest(attempt=1)
@@ -83,7 +83,7 @@ class GraspPlanner(LeafSystem):
 
     def __init__(self, *, place_xy, start_time: float = 0.0, period: float = 0.05,
                  config: PlannerConfig | None = None, scenario: Scenario | None = None,
-                 placing: TaskPlacing | None = None, surfaces=()):
+                 placing: TaskPlacing | None = None, surfaces=(), handover=None):
         """
         Args:
             place_xy: (2,) world xy where the target object's frame origin is placed [m].
@@ -96,6 +96,9 @@ class GraspPlanner(LeafSystem):
             placing: the task's placing (`tg_drake.planning.task_motion.task_placing`); None
                 places the object at `place_xy`, its orientation kept.
             surfaces: `tg_drake.planning.task_motion.Surface` boxes on the table (obstacles).
+            handover: a pass's receiver (`tg_drake.planning.handover.Handover`): the plan hands
+                the object over to it; its part comes from the category distribution of the
+                optional ``grasp_semantics`` input.
         """
         super().__init__()
         if len(place_xy) != 2:
@@ -106,6 +109,7 @@ class GraspPlanner(LeafSystem):
         self._config = config or PlannerConfig()
         self._scenario = scenario
         self._placing, self._surfaces = placing, tuple(surfaces)
+        self._handover = handover
 
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
@@ -114,6 +118,8 @@ class GraspPlanner(LeafSystem):
         self._state_port = self.DeclareVectorInputPort("iiwa.state", 14)
         self._request_port = self.DeclareAbstractInputPort(
             "plan_request", AbstractValue.Make(PlanRequest()))
+        self._semantics_port = self.DeclareAbstractInputPort(  # a pass's receiver part
+            "grasp_semantics", AbstractValue.Make(GraspSemantics({}, {}, {}, None)))
 
         self._memory = self.DeclareAbstractState(
             AbstractValue.Make(_Memory(q_hold=np.asarray(IIWA_HOME, float))))
@@ -179,11 +185,15 @@ class GraspPlanner(LeafSystem):
                 memory,
                 failure_reason="no grasp candidates" if scene.objects else "no objects seen")
         else:
+            semantics = (self._semantics_port.Eval(context)
+                         if self._semantics_port.HasValue(context) else None)
             result = plan_for_scene(scene, grasps, place_xy=self._place_xy,
                                     q_start=memory.q_hold, config=self._config,
                                     scenario=self._scenario,
                                     exclude_parts=tuple(request.exclude_parts), max_parts=1,
-                                    placing=self._placing, surfaces=self._surfaces)
+                                    placing=self._placing, surfaces=self._surfaces,
+                                    handover=self._handover,
+                                    category=semantics.category if semantics else None)
             if result.status == "planned":
                 memory = dataclasses.replace(memory, result=result, t_plan=context.get_time())
             else:

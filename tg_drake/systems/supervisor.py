@@ -53,6 +53,7 @@ from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
 from tg_drake.tasks.judge import (
     REST_POSE_OF_TASK,
     judge_on_surface,
+    judge_pass,
     judge_pour,
     judge_rest_pose,
 )
@@ -152,12 +153,14 @@ class MonitorModel:
     X_WT: tuple = tuple(map(tuple, np.eye(4)))  # 4×4 table frame, as nested tuples
     is_tool: bool = False
     surfaces: tuple = ()  # (name, frozenset of GeometryId) per surface
+    receiver: HandGeometries | None = None  # pass: the target, the receiver's fingers, the table
 
     @classmethod
     def from_plant(cls, plant, *, object_body, wsg_instance, table_instance,
                    p_OC=(0.0, 0.0, 0.0), X_WT=None, is_tool: bool = False,
-                   surfaces=()) -> "MonitorModel":
-        """`surfaces`: names of the surfaces' bodies in the table's model instance."""
+                   surfaces=(), receiver_instance=None) -> "MonitorModel":
+        """`surfaces`: names of the surfaces' bodies in the table's model instance;
+        `receiver_instance`: a pass's receiver WSG (tg_drake.receiver), or None."""
         surface_ids = tuple(
             (name, frozenset(plant.GetCollisionGeometriesForBody(
                 plant.GetBodyByName(body, table_instance)))) for name, body in surfaces)
@@ -167,7 +170,10 @@ class MonitorModel:
                    int(object_body.index()), int(plant.GetBodyByName("body", wsg_instance).index()),
                    tuple(float(v) for v in p_OC),
                    tuple(map(tuple, np.eye(4) if X_WT is None else np.asarray(X_WT, float))),
-                   bool(is_tool), surface_ids)
+                   bool(is_tool), surface_ids,
+                   None if receiver_instance is None else HandGeometries.from_plant(
+                       plant, object_body=object_body, wsg_instance=receiver_instance,
+                       table_instance=table_instance))
 
 
 class Phase(enum.StrEnum):
@@ -193,6 +199,8 @@ class _Memory:
     z_G_grasped: float = 0.0  # [m] gripper body height when the grasp closed
     z_O_grasped: float = 0.0  # [m] object height when the grasp closed
     X_WO_picked: RigidTransform | None = None  # object pose when the plan started
+    z_released: tuple = ()  # [m] pass: the object's heights from the robot's release on
+    t_released: float | None = None  # [s] pass: simulated time of the robot's release
     held_at_pour: bool = False  # the gripper held the container at the end of the pour
     outcome: Outcome | None = None  # the final outcome
 
@@ -268,6 +276,7 @@ class Supervisor(LeafSystem):
         self._status_port = self.DeclareAbstractInputPort(
             "plan_status", AbstractValue.Make(PlanStatus(PlanState.planning)))
         self._wsg_port = self.DeclareVectorInputPort("wsg.state", 4)
+        self._receiver_port = self.DeclareVectorInputPort("receiver.state", 4)  # pass only
         self._poses_port = self.DeclareAbstractInputPort(
             "body_poses", AbstractValue.Make([RigidTransform()]))
         self._contacts_port = self.DeclareAbstractInputPort(
@@ -362,6 +371,12 @@ class Supervisor(LeafSystem):
             why = f"{status}" + (f" ({reason})" if reason else "")
             task_outcome = TaskOutcome(self._task, False, {},
                                        f"not done: the run ended {why}: {detail}")
+            # pass: a plan refused for its hand-over says so (the receiver's reach or grasp).
+            handover = next((r[r.index("hand-over:"):] for _, r in memory.failures
+                             if "hand-over:" in r), "")
+            if self._task == "pass" and handover:
+                task_outcome = TaskOutcome(self._task, False, {"handed_over": False},
+                                           f"not done: {handover}; the run ended {why}: {detail}")
         return dataclasses.replace(memory, phase=Phase.done, outcome=Outcome(
             status, reason, detail, reachable_parts=reachable,
             unreachable_parts=memory.collisions, requeries=memory.requeries,
@@ -447,8 +462,14 @@ class Supervisor(LeafSystem):
         plan, t_plan = memory.status.plan, memory.status.t_plan
         t = context.get_time() - t_plan
         pour = () if plan.t_pour is None else (plan.t_pour[1],)
-        key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, plan.duration)
+        t_handover = getattr(plan, "t_handover", None)  # plans without a hand-over may lack it
+        handover = () if t_handover is None else (t_handover[1],)
+        key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, *handover, plan.duration)
         key_time = key_times[memory.checks_passed]
+        if memory.t_released is not None and t < key_time:  # pass: the height while held
+            X = self._poses_port.Eval(context)[self._model.object_body]
+            z = X.multiply(np.array(self._model.p_OC))[2]  # its box centre
+            return dataclasses.replace(memory, z_released=memory.z_released + (float(z),))
         if t < key_time:
             return memory
         contacts = self._contacts_port.Eval(context)
@@ -475,6 +496,15 @@ class Supervisor(LeafSystem):
             return dataclasses.replace(memory, checks_passed=2)
         if memory.checks_passed == 2 and pour:  # the pour's hold is over
             return dataclasses.replace(memory, checks_passed=3, held_at_pour=hand.held)
+        if memory.checks_passed == 2 and handover:  # pass: the robot has let go
+            return dataclasses.replace(memory, checks_passed=3, t_released=context.get_time(),
+                                       z_released=(float(X_WO.multiply(
+                                           np.array(self._model.p_OC))[2]),))
+        if handover:  # pass: the receiver has held it alone to the end of the plan
+            task = self._judge_pass(context, memory, contacts, hand, X_WO)
+            detail = ("handed over: " if task.success else "let go at the hand-over; ") \
+                + task.detail
+            return self._finish(memory, Status.lifted, Reason.none, detail, task)
         # The plan is over: let go, the table carries the object (a pad may still brush it).
         if not np.all(np.isfinite(X_WO.GetAsMatrix4())):
             return self._finish(memory, Status.failed, Reason.simulation,
@@ -525,8 +555,27 @@ class Supervisor(LeafSystem):
             counts = self._count_contents(poses)
             into = self._pour_into if task == "pourOut" else self._container
             return judge_pour(task, counts, into=into, held=held_at_pour)
+        if task == "pass":
+            return TaskOutcome(task, False, {"handed_over": False},
+                               "the station has no receiver: placed as for pick-and-place")
         return TaskOutcome(task, False, {}, f"the {task} motion and check are not implemented "
                            "yet: the object was placed as for pick-and-place")
+
+    def _judge_pass(self, context, memory: _Memory, contacts, hand, X_WO) -> TaskOutcome:
+        """pass at the end of the plan: the receiver's hold since the robot's release."""
+        receiver = self._model.receiver
+        if receiver is None or not self._receiver_port.HasValue(context):
+            return TaskOutcome("pass", False, {}, "the station has no receiver")
+        got = hand_contact(contacts, wsg_q=self._receiver_port.Eval(context)[:2],
+                           geometries=receiver)
+        z = memory.z_released + (float(X_WO.multiply(np.array(self._model.p_OC))[2]),)
+        return judge_pass(receiver_left=got.left, receiver_right=got.right,
+                          receiver_opening=got.opening,
+                          robot_touches=hand.left or hand.right,
+                          on_table=touches_table(contacts, geometries=self._model.geometries),
+                          z_W=np.array(z), held_for=context.get_time() - memory.t_released,
+                          hold_duration=memory.status.plan.handover.hold_duration,
+                          receiver_part=memory.status.plan.handover.part)
 
     # Outputs.
     def _memory_of(self, context) -> _Memory:

@@ -9,14 +9,16 @@ pose, whether it is let go and on what it rests, where the contents' spheres are
   within `PLACE_XY_TOLERANCE` of the place target;
 - p&pOn (`judge_on_surface`): let go, resting on the named surface's geometry (not on the table);
 - pourOut / pourIn (`judge_pour`): at least `POUR_SUCCESS_FRACTION` of the spheres end in the
-  receiving vessel (the bowl; the held container for pourIn), the container still held.
+  receiving vessel (the bowl; the held container for pourIn), the container still held;
+- pass (`judge_pass`): the receiver alone holds it `PASS_HOLD_DURATION` after the robot's release,
+  its height steady within `PASS_HEIGHT_TOLERANCE`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from tg_drake.outcome import PLACE_XY_TOLERANCE
+from tg_drake.outcome import PLACE_XY_TOLERANCE, is_held
 from tg_drake.perception.ground_truth import pose_from_transform
 from tg_drake.tasks.contents import ContentsModel, count_contents
 from tg_drake.tasks.outcome import TaskOutcome
@@ -95,3 +97,49 @@ def contents_counter(model: ContentsModel, *, containers: dict, table_z: float):
         return count_contents(model, body_poses, table_z=table_z, containers={
             name: (body_poses[index], obj) for name, (index, obj) in containers.items()})
     return count
+
+
+# [m] pass: the object's height may change this much while the receiver holds it alone (its
+# mount's PD sag under a 1 kg load is 0.5 mm; a slip in the pads shows as more).
+PASS_HEIGHT_TOLERANCE = 0.01
+PASS_HOLD_DURATION = 1.0  # [s] the receiver must hold it alone this long after the robot's release
+
+
+def judge_pass(*, receiver_left: bool, receiver_right: bool, receiver_opening: float,
+               robot_touches: bool, on_table: bool, z_W, held_for: float,
+               hold_duration: float = PASS_HOLD_DURATION,
+               tolerance: float = PASS_HEIGHT_TOLERANCE, receiver_part: str = "") -> TaskOutcome:
+    """pass: `held_for` [s] after the robot let go, the object touches both of the receiver's
+    pads (`receiver_left`, `receiver_right`; the receiver's fingers `receiver_opening` [m] apart,
+    more than closed on air: `tg_drake.outcome.is_held`), touches neither the robot's pads
+    (`robot_touches`) nor the table (`on_table`), and its height, sampled from the release to
+    now (`z_W` [m], world), stayed within `tolerance` [m]; `held_for` ≥ `hold_duration` [s].
+    `receiver_part`: the part the receiver took (reported)."""
+    z = np.asarray(z_W, float).ravel()
+    drift = float(np.ptp(z)) if len(z) else float("inf")
+    held = is_held(receiver_left, receiver_right, receiver_opening)  # the one rule for "held"
+    measure = {"receiver_held": held, "receiver_pads": [bool(receiver_left), bool(receiver_right)],
+               "receiver_opening_m": round(float(receiver_opening), 4),
+               "robot_touches": bool(robot_touches), "on_table": bool(on_table),
+               "height_change_m": round(drift, 4) if np.isfinite(drift) else None,
+               "held_for_s": round(float(held_for), 3), "receiver_part": receiver_part}
+    if not held:
+        pads = [n for n, t in (("left", receiver_left), ("right", receiver_right)) if not t]
+        why = (f"its {' and '.join(pads)} pad{'s' if len(pads) > 1 else ''} not touching"
+               if pads else "its fingers closed on air")
+        where = " (it lies on the table)" if on_table else ""
+        return TaskOutcome("pass", False, measure, f"the receiver does not hold it: {why}{where}")
+    if robot_touches:
+        return TaskOutcome("pass", False, measure, "the robot's pads still touch the object")
+    if on_table:
+        return TaskOutcome("pass", False, measure, "the object touches the table")
+    if held_for < hold_duration:
+        return TaskOutcome("pass", False, measure,
+                           f"held alone only {held_for:.2f} s (< {hold_duration} s)")
+    if not drift <= tolerance:
+        return TaskOutcome("pass", False, measure,
+                           f"its height changed {drift * 1000:.0f} mm while the receiver held "
+                           f"it (> {tolerance * 1000:.0f} mm): it slipped")
+    return TaskOutcome("pass", True, measure,
+                       f"the receiver held it alone {held_for:.1f} s, its height steady within "
+                       f"{drift * 1000:.1f} mm")

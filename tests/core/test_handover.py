@@ -1,0 +1,207 @@
+"""The pass on arrays: the receiver's mount and hand-over geometry, its grasp chosen clear of the
+robot's gripper, the part the logic names for it, and the judge of its hold."""
+
+import numpy as np
+import pytest
+
+from tg_drake.errors import ScenarioError
+from tg_drake.logic.receive import receiver_parts
+from tg_drake.planning.handover import (
+    Handover,
+    ReceiverConfig,
+    choose_receiver_grasp,
+    mount_configuration,
+    mount_pose,
+    receiver_motion,
+    robot_gripper_points,
+)
+from tg_drake.tasks.judge import PASS_HEIGHT_TOLERANCE, judge_pass
+from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription
+
+# A top grasp: approach −z_W, fingers closing along y_W (across a bar lying along x_W).
+R_TOP = np.column_stack([[0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [-1.0, 0.0, 0.0]])
+GRASP_DEPTH = 0.055  # [m] the grasp point along +y_G (tg_drake.robot)
+
+
+def top_grasp(x: float, z: float) -> np.ndarray:
+    """The WSG frame whose grasp point is (x, 0, z)."""
+    X = np.eye(4)
+    X[:3, :3] = R_TOP
+    X[:3, 3] = [x, 0.0, z + GRASP_DEPTH]
+    return X
+
+
+def bar(height: float) -> ObjectDescription:
+    """A 240 × 25 × 25 mm bar along x_W centred at (0, 0, height): its x < 0 half the handle, the
+    rest the usable area (4 mm points through its volume)."""
+    g = np.arange(-0.12, 0.1201, 0.004)
+    h = np.arange(-0.0125, 0.01251, 0.004)
+    p = np.stack(np.meshgrid(g, h, h, indexing="ij"), axis=-1).reshape(-1, 3) + [0, 0, height]
+    labels = np.where(p[:, 0] < 0, PART_LABELS.index("handle"), PART_LABELS.index("usable_area"))
+    X_WO = np.eye(4)
+    X_WO[2, 3] = height
+    return ObjectDescription(p_W=p, n_W=np.zeros_like(p), labels=labels,
+                             visible=np.ones(len(p), bool), X_WO=X_WO,
+                             extents=np.array([0.24, 0.025, 0.025]), pose="sideways",
+                             pose_likelihood={"sideways": 1.0}, part_probabilities={},
+                             part_boxes={}, pregrasp_X_WG=np.zeros((0, 4, 4)),
+                             pregrasp_parts=np.zeros(0, int), is_tool=True)
+
+
+def candidates(xs) -> GraspCandidates:
+    X = np.array([top_grasp(x, 0.3) for x in xs])
+    parts = np.array([PART_LABELS.index("handle" if x < 0 else "usable_area") for x in xs])
+    n = len(xs)
+    return GraspCandidates(X_WG=X, parts=parts, p_part=np.ones(n), p_local=np.full(n, 0.5),
+                           score=np.full(n, 0.5))
+
+
+HANDOVER = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=180.0), np.eye(4))
+
+
+def choose(xs, *, handover=HANDOVER, robot_x=0.07, parts=None):
+    target = bar(0.3)
+    return choose_receiver_grasp(
+        candidates(xs), target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
+        X_WG_robot=top_grasp(robot_x, 0.3),
+        receiver_parts=parts or {"handle": 0.9, "usable_area": 0.1}, handover=handover,
+        table_z=0.0, retreat=0.1)
+
+
+def test_the_receiver_takes_the_handle_clear_of_the_robots_gripper():
+    grasp, why = choose([-0.07, 0.04, 0.09])
+    assert why == "" and grasp is not None
+    assert grasp.part == "handle" and grasp.candidate == 0
+    assert np.allclose(grasp.X_WR, top_grasp(-0.07, 0.3))
+    assert 0.0 < grasp.p_hold <= 1.0 and grasp.score == pytest.approx(
+        0.9 * 0.5 * grasp.p_hold)
+
+
+def test_no_receiver_grasp_clear_of_the_robots_fingers_is_said_so():
+    # Both candidates lie where the robot's housing and pads are (x 0.045 … 0.095 m).
+    grasp, why = choose([0.06, 0.08], parts={"usable_area": 1.0})
+    assert grasp is None
+    assert "clear of the robot's fingers" in why and "other object" in why
+
+
+def test_a_receiver_that_cannot_reach_is_said_so():
+    short = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=180.0, reach=0.3), np.eye(4))
+    grasp, why = choose([-0.07], handover=short)
+    assert grasp is None and "cannot reach" in why and "reach 0.3 m" in why
+
+
+def test_a_receiver_approaching_only_from_its_side_refuses_top_grasps():
+    side = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=180.0,
+                                   max_approach_angle=45.0), np.eye(4))
+    grasp, why = choose([-0.07], handover=side)
+    assert grasp is None and "within 45°" in why
+
+
+def test_the_robots_gripper_points_fill_its_housing_and_open_pads_swept_back():
+    p = robot_gripper_points(top_grasp(0.0, 0.3), retreat=0.1)
+    # The housing is 146 mm along the closing axis (y_W here); the pads open to 110 mm, their
+    # outer faces at ±(0.055 + 0.012) m, within it.
+    assert np.abs(p[:, 1]).max() == pytest.approx(0.073, abs=1e-6)
+    below = p[p[:, 2] < 0.3 + GRASP_DEPTH - 0.0151]  # under the housing: the pads only
+    assert np.abs(below[:, 1]).max() == pytest.approx(0.067, abs=1e-6)
+    # The retreat sweeps it 0.1 m up (−y_G = +z_W); the fingertips reach the grasp point's
+    # −0.041 m below it.
+    assert p[:, 2].min() == pytest.approx(0.3 + GRASP_DEPTH - 0.096, abs=1e-6)
+    # The housing's back face 0.0213 + 0.0725 / 2 m behind G (tg_drake.robot).
+    assert p[:, 2].max() == pytest.approx(0.3 + GRASP_DEPTH + 0.05755 + 0.1, abs=1e-6)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_mount_configuration_inverts_the_mount_pose(seed):
+    rng = np.random.default_rng(seed)
+    q = np.concatenate([rng.uniform(-1, 1, 3), rng.uniform(-3, 3, 1), rng.uniform(-1.4, 1.4, 1),
+                        rng.uniform(-3, 3, 1)])
+    assert np.allclose(mount_pose(mount_configuration(mount_pose(q))), mount_pose(q))
+    assert np.allclose(mount_configuration(mount_pose(q), near=q), q)
+
+
+def test_the_receiver_waits_back_and_above_the_hand_over_point():
+    X_WT = np.eye(4)
+    X_WT[:3, 3] = [0.75, 0.0, 0.0]
+    h = Handover(ReceiverConfig(xy=[-0.15, 0.0], height=0.3, yaw=90.0), X_WT)
+    assert np.allclose(h.point, [0.6, 0.0, 0.3])
+    assert np.allclose(h.direction, [0.0, 1.0, 0.0], atol=1e-12)
+    X = h.X_WR_wait
+    assert np.allclose(X[:3, 3], [0.6, -0.3, 0.75])
+    assert np.allclose(X[:3, 1], h.direction) and np.allclose(X[:3, :3].T @ X[:3, :3], np.eye(3))
+    assert np.allclose(h.object_pose(np.eye(4))[:3, 3], h.point)
+
+
+def test_the_receivers_motion_reaches_its_grasp_then_closes():
+    grasp, _ = choose([-0.07])
+    motion = receiver_motion(HANDOVER, grasp, t_arrive=20.0, t_earliest=5.0)
+    q_wait = mount_configuration(HANDOVER.X_WR_wait)
+    assert np.allclose(motion.configuration(5.0), q_wait)
+    assert np.allclose(motion.velocity(5.0), 0.0)
+    assert np.allclose(mount_pose(motion.configuration(motion.times[-1] + 1)), grasp.X_WR)
+    t_pre = motion.times[2]
+    assert motion.times[1] > 5.0 and t_pre == pytest.approx(20.0) and motion.t_arrive == 20.0
+    assert motion.times[3] == pytest.approx(20.0 + HANDOVER.config.look)
+    X_pre = mount_pose(motion.configuration(t_pre))
+    assert np.allclose(X_pre[:3, 3], grasp.X_WR[:3, 3] - 0.1 * grasp.X_WR[:3, 1])
+    assert motion.width(t_pre) == pytest.approx(0.11)
+    assert motion.width(motion.t_closed) == pytest.approx(-0.04)
+    assert motion.t_closed > motion.times[-1]
+
+
+def test_a_receiver_with_a_bad_field_is_refused_naming_it():
+    with pytest.raises(ScenarioError, match="receiver.max_approach_angle"):
+        ReceiverConfig(max_approach_angle=0.0).validate()
+    with pytest.raises(ScenarioError, match="receiver.xy"):
+        ReceiverConfig(xy=[0.0, float("nan")]).validate()
+
+
+def test_the_logic_names_the_handle_of_a_tool_for_the_receiver():
+    parts = receiver_parts({"knife": 1.0}, held="usable_area", parts=("handle", "usable_area"))
+    assert list(parts) == ["handle", "usable_area"] and parts["handle"] == pytest.approx(0.9)
+    held = receiver_parts({"knife": 1.0}, held="handle", parts=("handle", "usable_area"))
+    assert held == pytest.approx({"handle": 0.7, "usable_area": 0.3})
+    # Category probabilities whose rounding would sum above 1 are accepted.
+    near = receiver_parts({"knife": 0.5000005, "hammer": 0.4999995}, held="usable_area",
+                          parts=("handle", "usable_area"))
+    assert near["handle"] == pytest.approx(0.9)
+    # A cup held by its middle is taken by its middle's other side first.
+    cup = receiver_parts({"cup": 1.0}, held="middle", parts=("top", "middle", "bottom"))
+    assert max(cup, key=cup.get) == "middle" and sum(cup.values()) == pytest.approx(1.0)
+
+
+def judged(**changes):
+    args = dict(receiver_left=True, receiver_right=True, receiver_opening=0.02,
+                robot_touches=False, on_table=False, z_W=[0.3, 0.2995, 0.2992], held_for=1.0)
+    args.update(changes)
+    return judge_pass(**args)
+
+
+def test_judge_pass_success_is_the_receivers_steady_hold_alone():
+    ok = judged()
+    assert ok.task == "pass" and ok.success, ok
+    assert ok.measure["height_change_m"] == pytest.approx(0.0008)
+    assert ok.measure["receiver_held"] is True
+
+
+@pytest.mark.parametrize("change, words", [
+    (dict(receiver_right=False), "right pad not touching"),
+    (dict(receiver_opening=0.0005), "closed on air"),
+    (dict(robot_touches=True), "robot's pads"),
+    (dict(on_table=True), "touches the table"),
+    (dict(held_for=0.5), "only 0.50 s"),
+    (dict(z_W=[0.3, 0.3 - 2 * PASS_HEIGHT_TOLERANCE]), "slipped"),
+])
+def test_judge_pass_failures_say_why(change, words):
+    outcome = judged(**change)
+    assert not outcome.success and words in outcome.detail, outcome
+
+
+def test_a_turned_receiver_grasp_keeps_its_grasp_point_and_closes_across_the_approach():
+    from tg_drake.planning.handover import turned_about_width
+
+    X = top_grasp(-0.07, 0.3)
+    for V in turned_about_width(X):
+        assert np.allclose(V[:3, 3] + GRASP_DEPTH * V[:3, 1], [-0.07, 0.0, 0.3])
+        assert np.allclose(V[:3, 2], X[:3, 2])  # the pads' width axis kept
+        assert abs(V[:3, 0] @ X[:3, 1]) == pytest.approx(1.0)  # closes along the old approach

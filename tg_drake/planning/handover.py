@@ -1,0 +1,438 @@
+"""The pass: the robot carries the object to a hand-over pose, a second gripper takes it.
+
+    handover = Handover(config=ReceiverConfig(), X_WT=X_WT)
+    X_WO_handover = handover.object_pose(X_WO)            # the object's box centre at the point
+    grasp = choose_receiver_grasp(candidates, target=obj, X_WO=X_WO, X_WO_handover=X,
+                                  X_WG_robot=X_WG_place, receiver_parts={"handle": 0.9, ...},
+                                  handover=handover, table_z=z)
+    motion = receiver_motion(handover, grasp.X_WR, t_start=t_arrive)
+
+The receiver is a WSG 50 (its frame R is the WSG frame G of tg_drake.robot: fingers close along
+±x_R, it approaches along +y_R) on a kinematic mount (tg_drake.receiver): three prismatic joints
+along the world's axes and three revolute joints, so that X_WR = translation(x, y, z) ·
+Rz(yaw) · Ry(pitch) · Rx(roll) (`mount_pose`, `mount_configuration`).
+
+Geometry (`ReceiverConfig`, the scenario's `receiver` block, table frame): the hand-over point
+(`xy`, `height` above the table top) is where the object's box centre is handed over, its
+orientation as picked (the planner's place yaws turn it about the vertical). The receiver comes
+along the horizontal direction `yaw` (0: the table's +x, away from the robot; 180: towards the
+robot) and waits, before and while the robot carries, `standoff` back along that direction and
+`rise` above the point (out of the camera's view and above perception's height band, so that the
+scene it perceives is the table's). Its mount reaches at most `reach` from where it waits.
+
+The receiver's grasp (`choose_receiver_grasp`): the grasp candidates on the parts the logic names
+for a receiver (`tg_drake.logic.receive.receiver_parts`, given the part the robot holds), carried
+with the object into its hand-over pose, each also turned ±90° about its pads' width axis
+(`turned_about_width`: from the sides the table closed); those whose approach is within
+`max_approach_angle` of the receiver's direction and within its reach are checked by the
+feasibility core (`tg_drake.grasping.feasibility.grasp_feasibility`): clear of the robot's
+gripper — its housing and its pads open, swept back along the robot's retreat — and of the table,
+with something between the pads. Chosen: the best P(part) · P(grasp | local shape) · P(hold) among
+those whose contact mechanics carry the weight (combined margin ≥ 1), else among all.
+
+The receiver's motion (`receiver_motion`, mount joint space, smooth in time): from where it waits
+to its pre-grasp (`approach` back along +y_R from the grasp), a straight approach, the fingers
+close as the robot's do, and it holds; the robot opens and retreats meanwhile (the planner).
+
+Arrays in, arrays out: no Drake.
+"""
+
+
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tg_drake.errors import ScenarioError
+from tg_drake.grasping.feasibility import (
+    GRASP_DEPTH,
+    FeasibilityConfig,
+    grasp_feasibility,
+    gripper_boxes,
+)
+from tg_drake.robot import WSG_MAX_OPENING
+from tg_drake.tasks.judge import PASS_HOLD_DURATION
+from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription
+
+UP = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass
+class ReceiverConfig:
+    """The receiver of a pass (the scenario's `receiver` block; lengths in the table frame)."""
+
+    xy: list[float] = field(default_factory=lambda: [-0.15, 0.0])  # [m] the hand-over point on
+    # the table (the object's box centre is handed over above it); default: 0.6 m in front of the
+    # robot's base, where the arm carries comfortably
+    height: float = 0.3  # [m] of the hand-over point above the table top
+    yaw: float = 180.0  # [deg] about the table normal: the direction the receiver moves in to
+    # take the object (0: the table's +x, away from the robot; 180: towards the robot, a person
+    # across the table)
+    standoff: float = 0.3  # [m] it waits this far back along its direction from the point ...
+    rise: float = 0.45  # [m] ... and this far above it
+    reach: float = 0.8  # [m] its mount moves at most this far from where it waits
+    approach: float = 0.1  # [m] its pre-grasp stands this far back along −y_R from its grasp
+    max_approach_angle: float = 90.0  # [deg] its approach +y_R at most this far from its
+    # direction (90: any approach from its side of the object, from above included)
+    max_grasps: int = 48  # of those, the best by P(part) · P(grasp | local shape) checked by the
+    # feasibility core per hand-over pose (each check ~10 ms of a 2-core machine's time)
+    speed: float = 0.5  # [m/s] moving to its pre-grasp, while the robot carries the object, so
+    # as to be there when it arrives (peak: 1.875 × the mean) ...
+    turn_speed: float = 1.5  # [rad/s] ... and turning (each mount angle)
+    approach_speed: float = 0.1  # [m/s] the straight approach (peak: 1.875 × the mean)
+    look: float = 0.3  # [s] at its pre-grasp after the robot has arrived, before approaching:
+    # where the object is in the robot's hand is seen then (tg_drake.receiver.ReceiverDriver)
+    close_duration: float = 0.8  # [s] open → 0 (then → closed_width over squeeze_duration), as
+    # the robot's gripper closes (PlannerConfig)
+    squeeze_duration: float = 0.1  # [s]
+    settle_duration: float = 0.4  # [s] held closed before the robot opens
+    closed_width: float = -0.04  # [m] commanded past closed, as the robot's (PlannerConfig)
+    hold_duration: float = PASS_HOLD_DURATION  # [s] after the robot's release, the receiver must
+    # hold it alone this long (the task's success test, tg_drake.tasks.judge.judge_pass)
+    kp: float = 20000.0  # [N/m] the mount's prismatic PD gains (the receiver and a held object
+    kd: float = 1000.0  # [N·s/m] of 1 kg sag mg/kp = 0.5 mm)
+    kp_rotation: float = 500.0  # [N·m/rad] the revolute joints' (0.3 kg·m weight at 0.1 m: 2 mrad)
+    kd_rotation: float = 20.0  # [N·m·s/rad]
+    force_limit: float = 400.0  # [N] of each prismatic actuator (and [N·m] of each revolute)
+
+    def validate(self, where: str = "receiver") -> None:
+        """ScenarioError naming the field."""
+        if len(self.xy) != 2 or not all(math.isfinite(v) for v in self.xy):
+            raise ScenarioError(f"xy must be two finite numbers [m], got {self.xy}",
+                                field=f"{where}.xy")
+        checks = (("height", self.height > 0.0, "> 0 m"), ("yaw", math.isfinite(self.yaw),
+                                                           "a finite angle [deg]"),
+                  ("standoff", self.standoff >= 0.0, ">= 0 m"), ("rise", self.rise >= 0.0,
+                                                                 ">= 0 m"),
+                  ("reach", self.reach > 0.0, "> 0 m"), ("approach", self.approach >= 0.0,
+                                                         ">= 0 m"),
+                  ("max_approach_angle", 0.0 < self.max_approach_angle <= 180.0,
+                   "in (0, 180] deg"),
+                  ("max_grasps", self.max_grasps >= 1, ">= 1"),
+                  ("look", self.look >= 0.0, ">= 0 s"),
+                  ("speed", self.speed > 0.0, "> 0 m/s"),
+                  ("turn_speed", self.turn_speed > 0.0, "> 0 rad/s"),
+                  ("approach_speed", self.approach_speed > 0.0, "> 0 m/s"),
+                  ("close_duration", self.close_duration > 0.0, "> 0 s"),
+                  ("squeeze_duration", self.squeeze_duration >= 0.0, ">= 0 s"),
+                  ("settle_duration", self.settle_duration >= 0.0, ">= 0 s"),
+                  ("closed_width", self.closed_width < WSG_MAX_OPENING, "< the WSG's opening"),
+                  ("hold_duration", self.hold_duration > 0.0, "> 0 s"),
+                  ("kp", self.kp > 0.0, "> 0"), ("kd", self.kd >= 0.0, ">= 0"),
+                  ("kp_rotation", self.kp_rotation > 0.0, "> 0"),
+                  ("kd_rotation", self.kd_rotation >= 0.0, ">= 0"),
+                  ("force_limit", self.force_limit > 0.0, "> 0"))
+        for name, ok, allowed in checks:
+            value = getattr(self, name)
+            if not (ok and math.isfinite(value)):
+                raise ScenarioError(f"must be {allowed}, got {value}", field=f"{where}.{name}")
+
+
+# --- the mount ---------------------------------------------------------------------------------
+
+
+def _rz(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _ry(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def _rx(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def mount_pose(q) -> np.ndarray:
+    """4×4 X_WR of the mount's configuration q = (x, y, z [m], yaw, pitch, roll [rad])."""
+    q = np.asarray(q, float)
+    X = np.eye(4)
+    X[:3, :3] = _rz(q[3]) @ _ry(q[4]) @ _rx(q[5])
+    X[:3, 3] = q[:3]
+    return X
+
+
+def mount_configuration(X_WR: np.ndarray, near=None) -> np.ndarray:
+    """The mount's q (6,) of pose X_WR (the inverse of `mount_pose`); angles unwrapped to lie
+    within π of `near`'s (a q) when given."""
+    R = np.asarray(X_WR, float)[:3, :3]
+    pitch = math.asin(-max(-1.0, min(1.0, R[2, 0])))
+    if abs(math.cos(pitch)) > 1e-9:
+        yaw, roll = math.atan2(R[1, 0], R[0, 0]), math.atan2(R[2, 1], R[2, 2])
+    else:  # the closing axis vertical: yaw and roll turn about the same axis
+        yaw, roll = math.atan2(-R[0, 1], R[1, 1]), 0.0
+    q = np.array([*np.asarray(X_WR, float)[:3, 3], yaw, pitch, roll])
+    if near is None:
+        return q
+    # Of the two angle triples of one rotation, (yaw, pitch, roll) and (yaw + π, π − pitch,
+    # roll + π), each unwrapped to within π of `near`'s, the nearer one.
+    near = np.asarray(near, float)
+    best = None
+    for angles in (q[3:], np.array([yaw + np.pi, np.pi - pitch, roll + np.pi])):
+        a = near[3:] + (angles - near[3:] + np.pi) % (2 * np.pi) - np.pi
+        if best is None or np.abs(a - near[3:]).max() < np.abs(best - near[3:]).max():
+            best = a
+    q[3:] = best
+    return q
+
+
+# --- the hand-over geometry --------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Handover:
+    """A pass's receiver in the world: the scenario's `ReceiverConfig` and the table frame."""
+
+    config: ReceiverConfig
+    X_WT: np.ndarray  # 4×4 table frame
+
+    @property
+    def point(self) -> np.ndarray:
+        """(3,) world position of the hand-over point."""
+        c = self.config
+        return (np.asarray(self.X_WT, float) @ np.array([c.xy[0], c.xy[1], c.height, 1.0]))[:3]
+
+    @property
+    def direction(self) -> np.ndarray:
+        """(3,) unit world direction the receiver moves in (horizontal)."""
+        a = math.radians(self.config.yaw)
+        d = np.asarray(self.X_WT, float)[:3, :3] @ np.array([math.cos(a), math.sin(a), 0.0])
+        d[2] = 0.0
+        return d / np.linalg.norm(d)
+
+    @property
+    def X_WR_wait(self) -> np.ndarray:
+        """4×4 where the receiver waits: `standoff` back along its direction and `rise` above the
+        point, approaching along its direction (+y_R), its pads' width (z_R) vertical."""
+        y = self.direction
+        x = np.cross(y, UP)
+        X = np.eye(4)
+        X[:3, :3] = np.column_stack([x, y, UP])
+        X[:3, 3] = self.point - self.config.standoff * y + self.config.rise * UP
+        return X
+
+    def object_pose(self, X_WO: np.ndarray) -> np.ndarray:
+        """The perceived object frame (origin at its box centre) moved to the hand-over point,
+        its orientation kept."""
+        X = np.array(X_WO, float)
+        X[:3, 3] = self.point
+        return X
+
+
+def robot_gripper_points(X_WG: np.ndarray, *, retreat: float, spacing: float = 0.005
+                         ) -> np.ndarray:
+    """(N, 3) world points on the surfaces of the robot's WSG at X_WG with its pads open (as
+    they open at the release) and swept `retreat` [m] back along −y_G (its retreat): what the
+    receiver's gripper must stay clear of, `spacing` [m] apart (about perception's voxel). (A box
+    of the receiver's that cuts one of these boxes contains some of its surface: the inside adds
+    nothing but cost.)"""
+    out = []
+    for _, centre, half in gripper_boxes(WSG_MAX_OPENING, retreat):
+        axes = [np.linspace(c - h, c + h, max(2, int(np.ceil(2 * h / spacing)) + 1))
+                for c, h in zip(centre, half, strict=True)]
+        grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+        on_face = np.any(np.isclose(np.abs(grid - centre), half, rtol=0, atol=1e-9), axis=1)
+        out.append(grid[on_face])
+    p_G = np.concatenate(out)
+    return p_G @ np.asarray(X_WG, float)[:3, :3].T + np.asarray(X_WG, float)[:3, 3]
+
+
+@dataclass(frozen=True)
+class ReceiverGrasp:
+    """The receiver's chosen grasp at the hand-over."""
+
+    X_WR: np.ndarray  # 4×4 its grasp pose
+    part: str
+    candidate: int  # index into the GraspCandidates
+    p_part: float  # P(the receiver takes this part) (tg_drake.logic.receive)
+    p_local: float
+    p_hold: float
+    score: float  # p_part · p_local · p_hold
+    margin: float = float("inf")  # the contact mechanics' combined hold margin (< 1 slips)
+
+
+def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescription,
+                          X_WO: np.ndarray, X_WO_handover: np.ndarray, X_WG_robot: np.ndarray,
+                          receiver_parts: dict, handover: Handover, table_z: float,
+                          retreat: float, feasibility: FeasibilityConfig | None = None,
+                          category: dict | None = None, cache: dict | None = None
+                          ) -> tuple[ReceiverGrasp | None, str]:
+    """The receiver's best grasp at the hand-over (module doc), or (None, why there is none).
+
+    `X_WO`: the object's perceived pose, where the candidates were made; `X_WO_handover`: its pose
+    handed over; `X_WG_robot`: the robot's gripper there; `receiver_parts`: part → P(the receiver
+    takes it); `retreat` [m]: how far the robot backs out along −y_G after opening. `cache`: a
+    dict kept across the hand-over poses of one planning call: the feasibility of the receiver's
+    poses relative to the object and the robot's gripper does not change when the three are
+    turned together about the vertical (the planner's place yaws), so it is computed once per
+    robot grasp and set of poses."""
+    config = handover.config
+    feasibility = feasibility or FeasibilityConfig()
+    parts = np.asarray(candidates.parts, int)
+    names = [PART_LABELS[k] for k in parts]
+    p_recv = np.array([float(receiver_parts.get(n, 0.0)) for n in names])
+    on_part = np.flatnonzero(p_recv > 0)
+    wanted = ", ".join(p for p, v in receiver_parts.items() if v > 0) or "none"
+    if not len(on_part):
+        return None, (f"hand-over: no receiver grasp candidate on the parts a receiver takes "
+                      f"({wanted})")
+    # The candidates carried with the object (X_WR = X_WO_handover · X_WO⁻¹ · X_WG), each also
+    # turned about its pads' width axis (`turned_about_width`).
+    moved = np.asarray(X_WO_handover, float) @ np.linalg.inv(np.asarray(X_WO, float))
+    carried = np.einsum("ij,njk->nik", moved, np.asarray(candidates.X_WG, float)[on_part])
+    X_WR = np.array([V for X in carried for V in (X, *turned_about_width(X))])
+    on_part = np.repeat(on_part, 1 + len(TURNS))
+    cos_max = math.cos(math.radians(config.max_approach_angle))
+    toward = X_WR[:, :3, 1] @ handover.direction >= cos_max - 1e-9
+    wait = handover.X_WR_wait[:3, 3]
+    far = np.linalg.norm(X_WR[:, :3, 3] - wait, axis=1)
+    within = far <= config.reach
+    if not toward.any():
+        return None, (f"hand-over: no receiver grasp on {wanted} approaches within "
+                      f"{config.max_approach_angle:.0f}° of the receiver's direction")
+    if not (toward & within).any():
+        return None, (f"hand-over: the receiver cannot reach: its nearest grasp on {wanted} is "
+                      f"{far[toward].min():.2f} m from where it waits (reach {config.reach} m)")
+    keep = np.flatnonzero(toward & within)
+    prior = p_recv[on_part[keep]] * np.asarray(candidates.p_local, float)[on_part[keep]]
+    keep = keep[np.argsort(-prior, kind="stable")[:config.max_grasps]]
+    X_OG = np.linalg.inv(np.asarray(X_WO_handover, float)) @ np.asarray(X_WG_robot, float)
+    key = (np.round(X_OG, 6).tobytes(), round(float(X_WO_handover[2, 3]) - table_z, 6),
+           keep.tobytes())
+    if cache is None or key not in cache:
+        target_p_W = (np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3])
+        robot = robot_gripper_points(X_WG_robot, retreat=retreat)
+        f = grasp_feasibility(X_WR[keep], target_p_W=target_p_W, others_p_W=robot,
+                              table_z=table_z, approach=config.approach, category=category,
+                              config=feasibility)
+        if cache is not None:
+            cache[key] = f
+    else:
+        f = cache[key]
+    ok = np.array([not r for r in f.reasons], bool)
+    if not ok.any():
+        first = next((r for r in f.reasons if r), "")
+        return None, (f"hand-over: no receiver grasp on {wanted} clear of the robot's fingers "
+                      f"and the table ({len(keep)} tried; first: {first})")
+    idx = on_part[keep]
+    p_local = np.asarray(candidates.p_local, float)[idx]
+    score = np.where(ok, p_recv[idx] * p_local * f.p_hold, -1.0)
+    # Poses whose contact mechanics hold the weight (margin ≥ 1) first, then by score.
+    margin = np.array([h.margin >= 1.0 for h in f.holds], bool) & ok
+    best = int(np.argmax(score + 2.0 * margin))  # scores lie in [0, 1]
+    i = int(idx[best])
+    return ReceiverGrasp(X_WR[keep][best], names[i], i, float(p_recv[i]), float(p_local[best]),
+                         float(f.p_hold[best]), float(score[best]),
+                         float(f.holds[best].margin)), ""
+
+
+TURNS = (np.pi / 2, -np.pi / 2)  # [rad] the turns of `turned_about_width`
+
+
+def turned_about_width(X_WG: np.ndarray) -> list[np.ndarray]:
+    """X_WG turned about its pads' width axis z_G through its grasp point by each of TURNS: the
+    pads still close across the same section of the part, from another side. In the air the
+    receiver may come from the sides the table closed to the robot (under a tool lying on it), and
+    a tool held horizontally is best squeezed from above and below: its weight's lever about a
+    vertical closing axis is nil."""
+    out = []
+    p_grasp = X_WG[:3, 3] + GRASP_DEPTH * X_WG[:3, 1]
+    for a in TURNS:
+        c, s_ = math.cos(a), math.sin(a)
+        R = X_WG[:3, :3] @ np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
+        X = np.eye(4)
+        X[:3, :3] = R
+        X[:3, 3] = p_grasp - GRASP_DEPTH * R[:, 1]
+        out.append(X)
+    return out
+
+
+# --- the receiver's motion ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class HandoverMotion:
+    """The receiver's commanded mount configuration and finger opening over plan time: knots
+    joined by quintic time scalings (zero velocity and acceleration at each knot)."""
+
+    times: tuple  # (K,) [s] increasing
+    q: np.ndarray  # (K, 6) mount configurations at the knots
+    width_times: tuple  # (L,) [s]
+    widths: tuple  # (L,) commanded opening [m], linear between the knots
+    t_closed: float  # [s] the receiver's fingers have closed and settled
+    X_WR_grasp: np.ndarray  # 4×4 its grasp pose
+    part: str = ""  # the part it takes
+    hold_duration: float = PASS_HOLD_DURATION  # [s] it must hold it alone after the release
+    X_WG_robot: np.ndarray | None = None  # 4×4 the robot's gripper at the hand-over pose
+    t_arrive: float = 0.0  # [s] the robot has arrived there
+
+    def _segment(self, t: float):
+        times = self.times
+        if t <= times[0]:
+            return 0, 0.0, 0.0
+        if t >= times[-1]:
+            return len(times) - 2, 1.0, 0.0
+        k = int(np.searchsorted(times, t, side="right") - 1)
+        d = times[k + 1] - times[k]
+        return k, (t - times[k]) / d, d
+
+    def configuration(self, t: float) -> np.ndarray:
+        """(6,) mount q at plan time t."""
+        k, u, _ = self._segment(t)
+        s = u ** 3 * (10 - 15 * u + 6 * u * u)
+        return self.q[k] + s * (self.q[k + 1] - self.q[k])
+
+    def velocity(self, t: float) -> np.ndarray:
+        """(6,) its time derivative."""
+        k, u, d = self._segment(t)
+        if d == 0.0:
+            return np.zeros(6)
+        ds = 30 * u * u * (1 - u) ** 2 / d
+        return ds * (self.q[k + 1] - self.q[k])
+
+    def width(self, t: float) -> float:
+        return float(np.interp(t, self.width_times, self.widths))
+
+
+def _duration(q_a: np.ndarray, q_b: np.ndarray, speed: float, turn_speed: float,
+              minimum: float) -> float:
+    """[s] a quintic move between two mount configurations, its peak speed (1.875 × the mean) at
+    most `speed` [m/s] and `turn_speed` [rad/s]."""
+    d = max(float(np.linalg.norm(q_b[:3] - q_a[:3])) / speed,
+            float(np.abs(q_b[3:] - q_a[3:]).max()) / turn_speed)
+    return max(minimum, 1.875 * d)
+
+
+def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float,
+                    t_earliest: float = 0.0, X_WG_robot: np.ndarray | None = None
+                    ) -> HandoverMotion:
+    """From where it waits to its pre-grasp, there when the robot arrives at the hand-over pose
+    (`t_arrive`, plan time) if it can leave early enough (not before `t_earliest`: the object
+    lifted), held there `look` seconds more, the straight approach, closing, held to the end."""
+    c = handover.config
+    q_wait = mount_configuration(handover.X_WR_wait)
+    X_pre = np.array(grasp.X_WR, float)
+    X_pre[:3, 3] -= c.approach * X_pre[:3, 1]
+    q_pre = mount_configuration(X_pre, near=q_wait)
+    q_grasp = mount_configuration(grasp.X_WR, near=q_pre)
+    move = _duration(q_wait, q_pre, c.speed, c.turn_speed, 1.0)
+    t_start = max(t_earliest, t_arrive - move)
+    t_pre = t_start + move
+    t_look = max(t_pre, t_arrive) + c.look
+    t_at = t_look + max(0.5, 1.875 * c.approach / c.approach_speed)
+    t_zero = t_at + c.close_duration
+    t_squeezed = t_zero + c.squeeze_duration
+    t_closed = t_squeezed + c.settle_duration
+    return HandoverMotion(
+        times=(0.0, t_start, t_pre, t_look, t_at),
+        q=np.array([q_wait, q_wait, q_pre, q_pre, q_grasp]),
+        width_times=(0.0, t_at, t_zero, t_squeezed),
+        widths=(WSG_MAX_OPENING, WSG_MAX_OPENING, 0.0, c.closed_width),
+        t_closed=t_closed, X_WR_grasp=np.array(grasp.X_WR, float), part=grasp.part,
+        hold_duration=c.hold_duration,
+        X_WG_robot=None if X_WG_robot is None else np.asarray(X_WG_robot, float),
+        t_arrive=float(t_arrive))
