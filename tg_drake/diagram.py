@@ -22,7 +22,9 @@ Wiring (docs/design.md, "The diagram"):
     scene_description, ranked_grasps, iiwa.state, plan_request ─▶ planner ─▶ iiwa.desired_state,
         wsg.position, plan_status
     scene_description, grasp_semantics, ranked_grasps, plan_status, wsg.state, body_poses,
-        contact_results ─▶ supervisor ─▶ collisions (─▶ logic), plan_request (─▶ planner), outcome
+        contact_results, perception_status ─▶ supervisor ─▶ collisions (─▶ logic), plan_request
+        (─▶ planner), outcome, perception_request (─▶ perception: look again after a
+        place-and-regrasp leg), target_xy (─▶ target)
 
 The supervisor closes the loop (unreachable parts become collision evidence, the logic's veto is
 checked after every re-query) and judges the execution: simulate until
@@ -67,8 +69,12 @@ class TargetSelector(LeafSystem):
         name: TargetSelector
         input_ports:
         - scene_description
+        - target_xy (optional)
         output_ports:
         - scene_description
+
+    ``target_xy`` (tuple: () or a world xy [m], the supervisor's): where a place-and-regrasp leg
+    put the target; it replaces the hint once given.
     """
 
     def __init__(self, p_W_hint):
@@ -76,13 +82,18 @@ class TargetSelector(LeafSystem):
         self._hint = np.asarray(p_W_hint, float)
         model = AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4)))
         self._in = self.DeclareAbstractInputPort("scene_description", model)
+        self._moved = self.DeclareAbstractInputPort("target_xy", AbstractValue.Make(()))
         self.DeclareAbstractOutputPort(
             "scene_description", lambda: AbstractValue.Make(
                 SceneDescription(objects=[], X_WT=np.eye(4))), self._calc,
-            prerequisites_of_calc={self.input_port_ticket(self._in.get_index())})
+            prerequisites_of_calc={self.input_port_ticket(p.get_index())
+                                   for p in (self._in, self._moved)})
 
     def _calc(self, context, output):
-        output.set_value(select_target(self._in.Eval(context), self._hint))
+        hint = self._hint
+        if self._moved.HasValue(context) and len(self._moved.Eval(context)):
+            hint = np.asarray(self._moved.Eval(context), float)
+        output.set_value(select_target(self._in.Eval(context), hint))
 
 
 @dataclass
@@ -164,7 +175,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     # The user points at the target's middle (its box centre; its frame's origin is at its base).
     target = builder.AddNamedSystem("target", TargetSelector(
         X_WO_target.multiply(box_centre(target_placement.id))))
-    builder.Connect(perception.GetOutputPort("scene_description"), target.get_input_port())
+    builder.Connect(perception.GetOutputPort("scene_description"), target.GetInputPort("scene_description"))
     scene = target.get_output_port()
 
     # Category prior, logic, grasp scoring.
@@ -250,6 +261,13 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     builder.Connect(supervisor.GetOutputPort("collisions"), logic.GetInputPort("collisions"))
     builder.Connect(supervisor.GetOutputPort("no_hold"), logic.GetInputPort("no_hold"))
     builder.Connect(supervisor.GetOutputPort("plan_request"), planner.GetInputPort("plan_request"))
+    # Legs (place-and-regrasp): the supervisor asks perception to look again, waits for the new
+    # latch, and tells the target selector where the target was put.
+    builder.Connect(supervisor.GetOutputPort("perception_request"),
+                    perception.GetInputPort("perception_request"))
+    builder.Connect(perception.GetOutputPort("perception_status"),
+                    supervisor.GetInputPort("perception_status"))
+    builder.Connect(supervisor.GetOutputPort("target_xy"), target.GetInputPort("target_xy"))
 
     ports = {"scene_description": scene,
              "category_prior": prior.GetOutputPort("category_prior"),

@@ -32,6 +32,8 @@ class PlanRequest:
 
     attempt: int = 0
     exclude_parts: tuple = ()
+    regrasp: bool = False  # a place-and-regrasp's first leg may be planned (p&pIn*: the object
+    # put down in an intermediate pose, `Plan.regrasp`), when the task's turn cannot be placed
 
 
 @dataclass(frozen=True)
