@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.framework import DiagramBuilder, EventStatus, LeafSystem
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.grasping.model import load_model
@@ -52,7 +52,12 @@ from tg_drake.systems.feasibility_system import GraspFeasibility
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.kernel_prior_system import KernelPriorSystem
 from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
-from tg_drake.systems.perception_system import GroundTruthPerception, PerceptionSystem
+from tg_drake.systems.perception_system import (
+    REQUEST_OFFSET,
+    REQUEST_PERIOD,
+    GroundTruthPerception,
+    PerceptionSystem,
+)
 from tg_drake.systems.supervisor import MonitorModel, Supervisor
 from tg_drake.table import surface_body_name
 from tg_drake.targeting import select_target
@@ -74,25 +79,37 @@ class TargetSelector(LeafSystem):
         - scene_description
 
     ``target_xy`` (tuple: () or a world xy [m], the supervisor's): where a place-and-regrasp leg
-    put the target; it replaces the hint once given.
+    put the target. The hint is latched state: a periodic event at perception's looks
+    (`REQUEST_PERIOD`, `REQUEST_OFFSET`: off the plant's step grid) replaces it by a new
+    ``target_xy``, so the output, and every cache downstream, depends on the scene and the latch
+    only, never on the supervisor's changing state.
     """
 
     def __init__(self, p_W_hint):
         super().__init__()
-        self._hint = np.asarray(p_W_hint, float)
         model = AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4)))
         self._in = self.DeclareAbstractInputPort("scene_description", model)
         self._moved = self.DeclareAbstractInputPort("target_xy", AbstractValue.Make(()))
+        self._hint = self.DeclareAbstractState(AbstractValue.Make(
+            tuple(float(v) for v in np.asarray(p_W_hint, float)[:2])))
+        self.DeclarePeriodicUnrestrictedUpdateEvent(REQUEST_PERIOD, REQUEST_OFFSET, self._look)
         self.DeclareAbstractOutputPort(
             "scene_description", lambda: AbstractValue.Make(
                 SceneDescription(objects=[], X_WT=np.eye(4))), self._calc,
-            prerequisites_of_calc={self.input_port_ticket(p.get_index())
-                                   for p in (self._in, self._moved)})
+            prerequisites_of_calc={self.input_port_ticket(self._in.get_index()),
+                                   self.abstract_state_ticket(self._hint)})
+
+    def _look(self, context, state):
+        if not self._moved.HasValue(context):
+            return EventStatus.DidNothing()
+        moved = tuple(float(v) for v in self._moved.Eval(context))
+        if not moved or moved == context.get_abstract_state(self._hint).get_value():
+            return EventStatus.DidNothing()
+        state.get_mutable_abstract_state(self._hint).set_value(moved)
+        return EventStatus.Succeeded()
 
     def _calc(self, context, output):
-        hint = self._hint
-        if self._moved.HasValue(context) and len(self._moved.Eval(context)):
-            hint = np.asarray(self._moved.Eval(context), float)
+        hint = np.asarray(context.get_abstract_state(self._hint).get_value(), float)
         output.set_value(select_target(self._in.Eval(context), hint))
 
 
@@ -175,7 +192,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     # The user points at the target's middle (its box centre; its frame's origin is at its base).
     target = builder.AddNamedSystem("target", TargetSelector(
         X_WO_target.multiply(box_centre(target_placement.id))))
-    builder.Connect(perception.GetOutputPort("scene_description"), target.GetInputPort("scene_description"))
+    builder.Connect(perception.GetOutputPort("scene_description"),
+                    target.GetInputPort("scene_description"))
     scene = target.get_output_port()
 
     # Category prior, logic, grasp scoring.

@@ -392,7 +392,7 @@ def test_a_regrasp_leg_then_perception_looks_again_and_the_final_leg_is_the_runs
 
 
 def test_when_the_regrasp_bound_is_reached_the_failure_says_so():
-    from tg_drake.systems.supervisor import _Memory, Phase
+    from tg_drake.systems.supervisor import Phase, _Memory
 
     f = Fixed(task="p&pInUpright")
     leg = (("part", "middle"), ("placed_pose", "sideways"), ("xy", [0.8, 0.0]), ("t_end", 1.0))

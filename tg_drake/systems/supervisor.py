@@ -20,8 +20,9 @@ every decision that spans stages is taken here, in simulated time, from port val
    counts gives `Outcome.task_outcome`; a run that ended before the end of its plan gets a failed
    task outcome saying why.
 5. **Legs** (place-and-regrasp, p&pIn*): for a given p&pIn* task, while fewer than
-   `SupervisorConfig.max_regrasps` legs are done, a plan request allows a first leg (`PlanRequest.regrasp`). A plan that ends with the
-   object put down in an intermediate pose (`Plan.regrasp`) is monitored like any other; placed,
+   `SupervisorConfig.max_regrasps` legs are done, a plan request allows a first leg
+   (`PlanRequest.regrasp`). A plan that ends with the object put down in an intermediate pose
+   (`Plan.regrasp`) is monitored like any other; placed,
    the leg is recorded (`Outcome.legs`), the supervisor asks perception to look again (the
    ``perception_request`` counter), waits for the new latch (``perception_status.request``),
    then runs the gate and asks for the next leg's plan from the new scene, with the same task.
