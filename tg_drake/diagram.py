@@ -188,7 +188,11 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
             X_WT=scenario.X_WT.GetDeterministicValue(),
             poses=[p.pose for p in scenario.objects],
             containments=[p.containment for p in scenario.objects],
-            spacing=config.perception.spacing, seed=scenario.random_seed))
+            spacing=config.perception.spacing, seed=scenario.random_seed,
+            body_indices=[int(station.object_body(p.instance_name).index())
+                          for p in scenario.objects]))
+        # Looking again (after a place-and-regrasp leg) describes the objects where they are.
+        builder.Connect(station.outputs["body_poses"], perception.GetInputPort("body_poses"))
     # The user points at the target's middle (its box centre; its frame's origin is at its base).
     target = builder.AddNamedSystem("target", TargetSelector(
         X_WO_target.multiply(box_centre(target_placement.id))))

@@ -305,10 +305,12 @@ def summary(result: dict) -> str:
         task = result["task_outcome"]
         lines.append(f"task check {task['task']} {'succeeded' if task['success'] else 'failed'}: "
                      f"{task['detail']}")
-    if o.get("legs"):  # place-and-regrasp legs before the final one
+    if o.get("legs"):  # place-and-regrasp legs (and retried grasps) before the final one
         lines.append(f"legs       {len(o['legs']) + 1}: " + "; ".join(
-            f"put down {leg['placed_pose']} at ({leg['xy'][0]:.3f}, {leg['xy'][1]:.3f}) m "
-            f"by its {leg['part']}" for leg in o["legs"]) + ", looked again, picked again")
+            (f"put down {leg['placed_pose']} at ({leg['xy'][0]:.3f}, {leg['xy'][1]:.3f}) m "
+             f"by its {leg['part']}" if leg["ended"] == "placed" else
+             f"{leg['ended']} by its {leg['part']}")
+            + ", looked again" for leg in o["legs"]) + ", then the final leg")
     if o["unreachable_parts"]:
         lines.append(f"closed loop: unreachable parts {o['unreachable_parts']} became "
                      f"collision evidence; {o['requeries']} "

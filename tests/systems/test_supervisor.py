@@ -387,15 +387,16 @@ def test_a_regrasp_leg_then_perception_looks_again_and_the_final_leg_is_the_runs
     o = f.outcome
     assert (o.status, o.final) == ("placed", True)
     assert o.task_outcome.success and o.task_outcome.measure["rest_pose"] == "upright"
-    assert o.as_dict()["legs"] == [{"part": "middle", "placed_pose": "upright",
-                                    "xy": [0.8, -0.1], "t_end": 0.31}]
+    assert o.as_dict()["legs"] == [{"part": "middle", "ended": "placed",
+                                    "placed_pose": "upright", "xy": [0.8, -0.1], "t_end": 0.31}]
 
 
 def test_when_the_regrasp_bound_is_reached_the_failure_says_so():
     from tg_drake.systems.supervisor import Phase, _Memory
 
     f = Fixed(task="p&pInUpright")
-    leg = (("part", "middle"), ("placed_pose", "sideways"), ("xy", [0.8, 0.0]), ("t_end", 1.0))
+    leg = (("part", "middle"), ("ended", "placed"), ("placed_pose", "sideways"),
+           ("xy", [0.8, 0.0]), ("t_end", 1.0))
     f.context.get_mutable_abstract_state(0).set_value(
         _Memory(phase=Phase.planning, attempt=2, legs=(leg,), t_leg=0.0))
     f.plan(failed(2, None, reason="the object can be picked but not placed: ..., the object "
@@ -406,3 +407,38 @@ def test_when_the_regrasp_bound_is_reached_the_failure_says_so():
     assert (o.status, o.reason, len(o.legs)) == ("failed", "unreachable", 1)
     assert o.detail.startswith("after 1 place-and-regrasp leg(s) (max_regrasps = 1)")
     assert "no place-and-regrasp leg allowed" in o.detail and not o.task_outcome.success
+
+
+def test_with_retries_a_missed_grasp_is_looked_at_again_once_its_plan_is_over(monkeypatch):
+    """max_retries 1: plans end with the arm home (return_home); the missed grasp is recorded,
+    perception asked to look only once the plan is over, then the next attempt is requested
+    (return_home off: no retry left); a second miss ends the run, saying so."""
+    import tg_drake.systems.supervisor as supervisor_module
+    from tg_drake.types import PerceptionStatus
+
+    monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: SimpleNamespace(
+        held=False, opening=0.0, left=False, right=False))
+    f = Fixed(config=SupervisorConfig(planning_start=0.0, period=0.01, planning_timeout=0.5,
+                                      max_retries=1))
+    look = f.supervisor.get_perception_status_input_port()
+    look.FixValue(f.context, PerceptionStatus(ok=True, request=0))
+    looks = f.supervisor.get_perception_request_output_port()
+    f.advance(0.001)
+    assert f.request == PlanRequest(attempt=1, return_home=True)
+    plan = SimpleNamespace(regrasp=False, t_grasp_closed=0.1, t_lift_done=0.2, duration=0.6,
+                           t_pour=None, R_turn=None, X_WO_place=np.eye(4))
+    f.plan(PlanStatus(PlanState.executing, attempt=1, part="top", t_plan=0.01, plan=plan))
+    f.advance(0.15)  # the miss
+    o = f.outcome
+    assert not o.final and [dict(x)["ended"] for x in o.legs] == ["missed"]
+    assert looks.Eval(f.context) == 0  # the arm is still on its way home
+    f.advance(0.62)
+    assert looks.Eval(f.context) == 1 and f.request.attempt == 1
+    look.FixValue(f.context, PerceptionStatus(ok=True, request=1))
+    f.advance(0.65)
+    assert f.request == PlanRequest(attempt=2, return_home=False)
+    f.plan(PlanStatus(PlanState.executing, attempt=2, part="top", t_plan=0.65, plan=plan))
+    f.advance(0.8)
+    o = f.outcome
+    assert (o.status, o.reason, len(o.legs)) == ("failed", "missed", 1)
+    assert o.detail.startswith("after 1 retried grasp(s) (max_retries = 1): fingers closed")

@@ -303,9 +303,9 @@ def finger_swapped(candidates: GraspCandidates) -> GraspCandidates:
 
 
 def _back_to_start(plan, q_start, target: ObjectDescription, obstacles, surfaces,
-                   config: PlannerConfig, scenario):
+                   config: PlannerConfig, scenario, *, regrasp: bool = True):
     """`plan` with a free move from its retreat back to `q_start` appended, the gripper open,
-    marked `regrasp`: (Plan, "") or (None, why)."""
+    marked `Plan.regrasp` = `regrasp`: (Plan, "") or (None, why)."""
     boxes = [(f"object{i}", RigidTransform(o.X_WO), tuple(o.extents))
              for i, o in enumerate(obstacles)]
     boxes += [(f"surface_{s.name}", RigidTransform(np.asarray(s.X_WB)), tuple(s.size))
@@ -328,18 +328,29 @@ def _back_to_start(plan, q_start, target: ObjectDescription, obstacles, surfaces
         breaks + [t0 + segment.duration], np.array([widths + [widths[-1]]]))
     return dataclasses.replace(
         plan, q_traj=q_traj, v_traj=q_traj.MakeDerivative(), width_traj=width_traj,
-        duration=t0 + segment.duration, regrasp=True,
+        duration=t0 + segment.duration, regrasp=regrasp,
         waypoints=dict(plan.waypoints, home=np.asarray(q_start, float)),
         segments=plan.segments + (("home", t0, t0 + segment.duration, segment.min_clearance),)
     ), ""
 
 
 def plan_task_leg(scene, candidates: GraspCandidates, *, place_xy, q_start, regrasp: bool = False,
-                  **kwargs) -> PlanResult:
+                  return_home: bool = False, **kwargs) -> PlanResult:
     """`tg_drake.planning.planner.plan_for_scene`, and where a p&pIn* task's turn in the hand
     cannot be placed: with `regrasp`, a place-and-regrasp's first leg (`plan_regrasp_leg`);
-    without, the reason says that none was allowed."""
+    without, the reason says that none was allowed. With `return_home` every plan ends with the
+    arm back at `q_start` (a regrasp leg does anyway)."""
     result = plan_for_scene(scene, candidates, place_xy=place_xy, q_start=q_start, **kwargs)
+    if result.status == "planned" and return_home:
+        target = scene.objects[candidates.target]
+        others = [o for i, o in enumerate(scene.objects) if i != candidates.target]
+        config = kwargs.get("config") or PlannerConfig()
+        plan, why = _back_to_start(result.plan, q_start, target, others, kwargs.get("surfaces", ()),
+                                   config, kwargs.get("scenario"), regrasp=False)
+        if plan is None:
+            return dataclasses.replace(result, status="unreachable", plan=None, reason=why,
+                                       candidate=None, part=None)
+        return dataclasses.replace(result, plan=plan)
     placing = kwargs.get("placing")
     if (result.status == "planned" or placing is None or placing.pose is None
             or placing.R_place is not None or TURNED_IN_HAND not in result.reason):

@@ -74,9 +74,10 @@ class GraspPlanner(LeafSystem):
     (its candidates best first; `tg_drake.planning.planner.plan_pick_and_place` with one part).
     Once a plan exists, ``iiwa.desired_state`` (q, v) and ``wsg.position`` (opening width [m];
     closing is commanded as width `PlannerConfig.closed_width`, the WSG driver's force limit sets
-    the grip) follow it in time from the event at which it was made; later requests are ignored,
-    except after a place-and-regrasp's first leg (`Plan.regrasp`, allowed by
-    `PlanRequest.regrasp`): once it is over, the next request is planned from its end posture.
+    the grip) follow it in time from the event at which it was made; a later request is planned
+    once the plan is over, from its end posture (the supervisor's next leg: after a
+    place-and-regrasp's first leg, `Plan.regrasp`, allowed by `PlanRequest.regrasp`, or after a
+    missed grasp, with `PlanRequest.return_home`).
 
     ``plan_status`` is a `PlanStatus` (from state and time only: feeding it to a supervisor whose
     outputs feed the logic makes no algebraic loop): planning, executing, done or failed,
@@ -173,10 +174,10 @@ class GraspPlanner(LeafSystem):
         if request.attempt <= memory.attempt:
             return EventStatus.DidNothing()
         if memory.result is not None:
-            # A place-and-regrasp's first leg that is over lets the next leg be planned, from
-            # where it left the arm; any other plan is followed to its end.
+            # A plan that is over lets the next request (the supervisor's next leg) be planned,
+            # from where it left the arm; until then the plan is followed.
             plan = memory.result.plan
-            if not (plan.regrasp and context.get_time() - memory.t_plan >= plan.duration):
+            if context.get_time() - memory.t_plan < plan.duration:
                 return EventStatus.DidNothing()
             memory = dataclasses.replace(memory, q_hold=plan.q(plan.duration), result=None,
                                          t_plan=None)
@@ -195,7 +196,8 @@ class GraspPlanner(LeafSystem):
                                    scenario=self._scenario,
                                    exclude_parts=tuple(request.exclude_parts), max_parts=1,
                                    placing=self._placing, surfaces=self._surfaces,
-                                   regrasp=bool(getattr(request, "regrasp", False)))
+                                   regrasp=bool(getattr(request, "regrasp", False)),
+                                   return_home=bool(getattr(request, "return_home", False)))
             if result.status == "planned":
                 memory = dataclasses.replace(memory, result=result, t_plan=context.get_time())
             else:

@@ -27,6 +27,10 @@ every decision that spans stages is taken here, in simulated time, from port val
    ``perception_request`` counter), waits for the new latch (``perception_status.request``),
    then runs the gate and asks for the next leg's plan from the new scene, with the same task.
    The final leg's outcome and task outcome are the run's.
+6. **Retries** (`SupervisorConfig.max_retries`, 0 = off): while retries are left, every plan
+   ends with the arm back at its start (`PlanRequest.return_home`); a missed grasp or a failed
+   lift is then recorded as a leg, and once that plan is over, perception looks again and the
+   next leg is planned from the new scene instead of ending the run.
 """
 
 
@@ -117,8 +121,8 @@ class Outcome:
     unreachable_parts: tuple = ()  # parts given to the logic as collision(Part) evidence
     requeries: int = 0  # how often the logic was asked again with new collision evidence
     task_outcome: TaskOutcome | None = None  # the task's physical check (None: no task given)
-    legs: tuple = ()  # the place-and-regrasp legs done before the final one: a dict each (part,
-    # placed_pose, xy [m], t_end [s])
+    legs: tuple = ()  # the legs done before the final one (place-and-regrasp, retries): a dict
+    # each (part, ended: placed / missed / slipped, placed_pose, xy [m] or None, t_end [s])
 
     @property
     def final(self) -> bool:
@@ -213,6 +217,9 @@ class _Memory:
     t_leg: float | None = None  # [s] when the current leg's gate began (None: planning_start)
     target_xy: tuple = ()  # world xy [m] where the last regrasp leg put the target (its box
     # centre, as planned); () before any
+    retries: int = 0  # legs ended by a missed grasp or a failed lift, looked at again
+    look_after: float | None = None  # [s] ask perception to look once this time has passed (the
+    # end of a plan whose grasp failed)
 
     def __deepcopy__(self, memo):
         return self  # immutable: the simulator's state copies may share it
@@ -404,8 +411,12 @@ class Supervisor(LeafSystem):
                 task_outcome: TaskOutcome | None = None, **changes) -> _Memory:
         memory = dataclasses.replace(memory, **changes)
         if memory.legs and status is Status.failed:
-            detail = (f"after {len(memory.legs)} place-and-regrasp leg(s) (max_regrasps = "
-                      f"{self._config.max_regrasps}): {detail}")
+            regrasps = len(memory.legs) - memory.retries
+            done = ([f"{regrasps} place-and-regrasp leg(s) (max_regrasps = "
+                     f"{self._config.max_regrasps})"] if regrasps else [])
+            done += ([f"{memory.retries} retried grasp(s) (max_retries = "
+                      f"{self._config.max_retries})"] if memory.retries else [])
+            detail = f"after {' and '.join(done)}: {detail}"
         reachable = (memory.status.part,) if memory.status is not None else ()
         if task_outcome is None and self._task:
             why = f"{status}" + (f" ({reason})" if reason else "")
@@ -509,16 +520,19 @@ class Supervisor(LeafSystem):
         z_G = poses[self._model.gripper_body].translation()[2]
         if memory.checks_passed == 0:  # the gripper has closed
             if not hand.held:
-                return self._finish(
-                    memory, Status.failed, Reason.missed,
-                    f"fingers closed to {hand.opening * 1000:.0f} mm without holding the object "
-                    f"(left pad {hand.left}, right pad {hand.right})")
+                why = (f"fingers closed to {hand.opening * 1000:.0f} mm without holding the "
+                       f"object (left pad {hand.left}, right pad {hand.right})")
+                if memory.retries < self._config.max_retries:
+                    return self._retry(context, memory, plan, X_WO, "missed")
+                return self._finish(memory, Status.failed, Reason.missed, why)
             return dataclasses.replace(memory, checks_passed=1, z_G_grasped=z_G,
                                        z_O_grasped=X_WO.translation()[2])
         if memory.checks_passed == 1:  # the lift is done
             rise = X_WO.translation()[2] - memory.z_O_grasped
             gripper_rise = z_G - memory.z_G_grasped
             if not hand.held or rise < self._config.min_rise_ratio * gripper_rise:
+                if memory.retries < self._config.max_retries:
+                    return self._retry(context, memory, plan, X_WO, "slipped")
                 return self._finish(memory, Status.grasped, Reason.slipped,
                                     f"the object rose {rise * 100:.1f} cm while the gripper rose "
                                     f"{gripper_rise * 100:.1f} cm")
@@ -556,21 +570,43 @@ class Supervisor(LeafSystem):
             return self._finish(memory, Status.lifted, Reason.slipped,
                                 f"place-and-regrasp leg {len(memory.legs) + 1}: {detail}", task)
         xy = tuple(round(float(v), 4) for v in plan.X_WO_place[:2, 3])
-        leg = (("part", memory.status.part),
+        return dataclasses.replace(self._next_leg(context, memory, X_WO, "placed", xy),
+                                   looks=memory.looks + 1, target_xy=xy)
+
+    def _retry(self, context, memory: _Memory, plan, X_WO: RigidTransform, ended: str
+               ) -> _Memory:
+        """A missed grasp or a failed lift with retries left: recorded as a leg; perception is
+        asked to look again once the plan (which ends with the arm back at its start) is over."""
+        return dataclasses.replace(self._next_leg(context, memory, X_WO, ended, None),
+                                   retries=memory.retries + 1,
+                                   look_after=memory.status.t_plan + plan.duration)
+
+    def _next_leg(self, context, memory: _Memory, X_WO: RigidTransform, ended: str, xy
+                  ) -> _Memory:
+        """The leg that ends now recorded (`Outcome.legs`), the state made ready for the next
+        (a new scene: no collision or no-hold evidence), looking."""
+        leg = (("part", memory.status.part), ("ended", ended),
                ("placed_pose", rest_pose(X_WO.GetAsMatrix4(), np.array(self._model.X_WT),
                                          is_tool=self._model.is_tool)),
-               ("xy", list(xy)), ("t_end", round(float(context.get_time()), 3)))
-        return dataclasses.replace(memory, phase=Phase.looking, looks=memory.looks + 1,
-                                   legs=memory.legs + (leg,), target_xy=xy, status=None,
-                                   checks_passed=0, held_at_pour=False, collisions=(),
-                                   no_hold=(), failures=(), t_leg=context.get_time())
+               ("xy", None if xy is None else list(xy)),
+               ("t_end", round(float(context.get_time()), 3)))
+        return dataclasses.replace(memory, phase=Phase.looking, legs=memory.legs + (leg,),
+                                   status=None, checks_passed=0, held_at_pour=False,
+                                   collisions=(), no_hold=(), failures=(),
+                                   t_leg=context.get_time())
 
     def _await_look(self, context, memory: _Memory) -> _Memory:
-        """Waits for perception to serve the latest request, then runs the gate again."""
+        """Waits for perception to serve the latest request, then runs the gate again (after a
+        failed grasp, asks for the look once its plan is over)."""
+        if memory.look_after is not None:
+            if context.get_time() < memory.look_after:
+                return memory
+            memory = dataclasses.replace(memory, looks=memory.looks + 1, look_after=None,
+                                         t_leg=context.get_time())
         if not self._perception_port.HasValue(context):
             return self._finish(memory, Status.failed, Reason.perception,
-                                "a place-and-regrasp leg was placed but perception cannot be "
-                                "asked to look again (perception_status is not connected)")
+                                "a leg ended but perception cannot be asked to look again "
+                                "(perception_status is not connected)")
         status: PerceptionStatus = self._perception_port.Eval(context)
         if status.request != memory.looks:
             if context.get_time() >= memory.t_leg + self._config.planning_timeout:
@@ -633,7 +669,9 @@ class Supervisor(LeafSystem):
         output.set_value(PlanRequest(attempt=memory.attempt,
                                      exclude_parts=memory.collisions + memory.no_hold,
                                      regrasp=(self._task in REST_POSE_OF_TASK and len(
-                                         memory.legs) < self._config.max_regrasps)))
+                                         memory.legs) - memory.retries
+                                         < self._config.max_regrasps),
+                                     return_home=memory.retries < self._config.max_retries))
 
     def _calc_dispenser(self, context, output):
         """1 while a pourIn plan holds the container under the dispenser (its first
@@ -655,7 +693,8 @@ class Supervisor(LeafSystem):
                    Phase.planning: f"waiting for plan attempt {memory.attempt}",
                    Phase.executing: f"executing the plan (checks passed: {memory.checks_passed})",
                    Phase.looking: f"waiting for perception to look again (request "
-                                  f"{memory.looks}, after leg {len(memory.legs)})"}
+                                  f"{memory.looks + (memory.look_after is not None)}, after "
+                                  f"leg {len(memory.legs)})"}
         # A run stopped now (a timeout, an error) has not done its task.
         task = (TaskOutcome(self._task, False, {}, f"not done: {waiting[memory.phase]}")
                 if self._task else None)
