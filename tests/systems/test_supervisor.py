@@ -17,21 +17,25 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource
 
+import tg_drake.systems.supervisor as supervisor_module
 from tg_drake.outcome import HandGeometries
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
 from tg_drake.systems.supervisor import (
     MonitorModel,
     Outcome,
+    Phase,
     Reason,
     Status,
     Supervisor,
     SupervisorConfig,
+    _Memory,
 )
 from tg_drake.types import (
     PART_LABELS,
     GraspCandidates,
     GraspSemantics,
+    PerceptionStatus,
     SceneDescription,
 )
 
@@ -346,9 +350,6 @@ def test_a_regrasp_leg_then_perception_looks_again_and_the_final_leg_is_the_runs
     leg's plan ends placed, the supervisor asks perception to look again (perception_request 1),
     waits for the new latch, runs the gate, asks for the next leg (no regrasp allowed any more:
     max_regrasps 1) and judges the final leg's task; the outcome records the leg."""
-    import tg_drake.systems.supervisor as supervisor_module
-    from tg_drake.types import PerceptionStatus
-
     held = iter([True, True, False] * 2)  # closed, lifted, let go: leg 1, then the final leg
     monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: SimpleNamespace(
         held=next(held), opening=0.05, left=True, right=True))
@@ -392,8 +393,6 @@ def test_a_regrasp_leg_then_perception_looks_again_and_the_final_leg_is_the_runs
 
 
 def test_when_the_regrasp_bound_is_reached_the_failure_says_so():
-    from tg_drake.systems.supervisor import Phase, _Memory
-
     f = Fixed(task="p&pInUpright")
     leg = (("part", "middle"), ("ended", "placed"), ("placed_pose", "sideways"),
            ("xy", [0.8, 0.0]), ("t_end", 1.0))
@@ -413,9 +412,6 @@ def test_with_retries_a_missed_grasp_is_looked_at_again_once_its_plan_is_over(mo
     """max_retries 1: plans end with the arm home (return_home); the missed grasp is recorded,
     perception asked to look only once the plan is over, then the next attempt is requested
     (return_home off: no retry left); a second miss ends the run, saying so."""
-    import tg_drake.systems.supervisor as supervisor_module
-    from tg_drake.types import PerceptionStatus
-
     monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: SimpleNamespace(
         held=False, opening=0.0, left=False, right=False))
     f = Fixed(config=SupervisorConfig(planning_start=0.0, period=0.01, planning_timeout=0.5,
