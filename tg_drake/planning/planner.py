@@ -497,7 +497,7 @@ def target_shapes(target: ObjectDescription) -> list[tuple]:
 
 
 # How a place failure of an object turned into the task's resting pose in the hand ends (the
-# place-and-regrasp hook of plan_for_scene looks for it).
+# place-and-regrasp of tg_drake.planning.regrasp.plan_task_leg looks for it).
 TURNED_IN_HAND = "the object turned to rest"
 
 # The key poses and motions of the pick; failures after them are the place's.

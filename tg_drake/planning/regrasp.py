@@ -6,19 +6,23 @@ from which a new grasp can.
                            regrasp=True, ...)
     result.plan.regrasp  # True: a first leg; the supervisor looks again and plans the next one
 
-The intermediate pose is chosen by trying, not by a rule per object: every resting pose the
-perceived object can take (`POSES`: the one it is in first, then the others, never the task's
-own), turned about the vertical by `TaskMotionConfig.regrasp_yaws`, standing where it stands now
-(the target stays where the user pointed). For each, in order, the perceived object is moved
-there rigidly (points, frame, part boxes) and given the pre-grasp hypotheses perception would
-make for it (`tg_drake.perception.pregrasp.part_pregrasps`); the second leg is *reachable* when
-one of them, on a part the current candidates grasp, has inverse-kinematics solutions for every
-key pose of the task's turned place (the planner's own refusals, turns and waypoint IK). For the
-first such intermediate poses (at most `TaskPlacing.regrasp_max_legs`), the first leg is planned
-in full: picked with the current candidates, placed in exactly that orientation, and the arm
-moved back to its start configuration, out of the camera's view, so that perception can look
-again. A lying bottle to stand up is then laid along another direction (its grasp's wrist turn
-reachable from there) and picked again.
+The intermediate pose is chosen by trying, not by a rule per object. The poses tried: every
+resting pose the perceived object can take (`POSES`: the one it is in, turned about the vertical
+by `TaskMotionConfig.regrasp_yaws`, then the others but the task's own), at each of
+`regrasp_spots` (fractions of the way from where it is to the place target; a spot where another
+perceived object stands is left out), the smallest turn of the object first (`intermediates`).
+For each, in order, the perceived object is moved there rigidly (points, frame, part boxes) and
+given the pre-grasp hypotheses perception would make for it, with the feasibility stage's
+approach variants (and, when its pose label stays, the current candidates moved with it); the
+second leg is *reachable* when one of them, on a part the current candidates grasp, has
+inverse-kinematics solutions for every key pose of the task's turned place (the planner's own
+refusals, turns and waypoint IK; its motions are planned when the leg is). For the first such
+intermediate poses (at most `TaskPlacing.regrasp_max_legs`), the first leg is planned in full:
+picked with the current candidates (each followed by its finger-swapped twin, the same grasp:
+the wrist's last joint cannot turn a half turn about the vertical otherwise), placed in exactly
+that orientation, then the arm moved back to its start configuration, out of the camera's view,
+so that perception can look again. A bottle lying at the far edge of the reach, to be stood up,
+is so put down nearer, lying as it was, and picked again.
 """
 
 from __future__ import annotations
@@ -216,7 +220,7 @@ def intermediates(target: ObjectDescription, placing: TaskPlacing, obstacles=()
 def plan_regrasp_leg(candidates: GraspCandidates, *, target: ObjectDescription, obstacles=(),
                      q_start, table_z: float, placing: TaskPlacing, direct: PlanResult,
                      config: PlannerConfig | None = None, scenario=None, exclude_parts=(),
-                     max_parts: int | None = None, surfaces=(), place_xy=None) -> PlanResult:
+                     max_parts: int | None = None, surfaces=()) -> PlanResult:
     """A place-and-regrasp's first leg (module doc) for the p&pIn* `placing` whose direct plan
     `direct` failed: a plan that puts the object down in an intermediate resting pose and moves
     the arm back to `q_start` (`Plan.regrasp`), or `direct` with the reason none was found."""

@@ -196,8 +196,8 @@ class GraspPlanner(LeafSystem):
                                    scenario=self._scenario,
                                    exclude_parts=tuple(request.exclude_parts), max_parts=1,
                                    placing=self._placing, surfaces=self._surfaces,
-                                   regrasp=bool(getattr(request, "regrasp", False)),
-                                   return_home=bool(getattr(request, "return_home", False)))
+                                   regrasp=request.regrasp,
+                                   return_home=request.return_home)
             if result.status == "planned":
                 memory = dataclasses.replace(memory, result=result, t_plan=context.get_time())
             else:

@@ -551,7 +551,7 @@ class Supervisor(LeafSystem):
                 memory.X_WO_picked.translation())
         ok, detail = placed(X_WO_expected, X_WO, plan.X_WO_place[:2, 3],
                             released=on_table and not hand.held, p_OC=self._model.p_OC)
-        if getattr(plan, "regrasp", False):
+        if plan.regrasp:
             return self._after_leg(context, memory, plan, X_WO, ok, detail)
         task = self._task_check(X_WO, plan, contacts, released=not hand.held, poses=poses,
                                 held_at_pour=memory.held_at_pour)
