@@ -17,11 +17,11 @@ approach variants (and, when its pose label stays, the current candidates moved 
 second leg is *reachable* when one of them, on a part the current candidates grasp, has
 inverse-kinematics solutions for every key pose of the task's turned place (the planner's own
 refusals, turns and waypoint IK; its motions are planned when the leg is). For the first such
-intermediate poses (at most `TaskPlacing.regrasp_max_legs`), the first leg is planned in full:
-picked with the current candidates (each followed by its finger-swapped twin, the same grasp:
-the wrist's last joint cannot turn a half turn about the vertical otherwise), placed in exactly
-that orientation, then the arm moved back to its start configuration, out of the camera's view,
-so that perception can look again. A bottle lying at the far edge of the reach, to be stood up,
+intermediate poses (at most `regrasp_max_legs`, of `regrasp_max_poses` examined), the first
+leg is planned in full: picked with the current candidates (each followed by its
+finger-swapped twin, the same grasp: the wrist's last joint cannot turn a half turn about the
+vertical otherwise), placed in exactly that orientation, then the arm moved back to its start
+configuration, out of the camera's view, so that perception can look again. A bottle lying at the far edge of the reach, to be stood up,
 is so put down nearer, lying as it was, and picked again.
 """
 
@@ -237,7 +237,7 @@ def plan_regrasp_leg(candidates: GraspCandidates, *, target: ObjectDescription, 
     twins = finger_swapped(candidates)
     tried, planned_legs = [], 0
     total_time = direct.planning_time
-    for inter in intermediates(target, placing, obstacles):
+    for inter in intermediates(target, placing, obstacles)[:placing.regrasp_max_poses]:
         label = (f"{inter.pose} turned {np.rad2deg(inter.yaw):.0f} deg at "
                  f"({inter.X_WO[0, 3]:.3f}, {inter.X_WO[1, 3]:.3f}) m")
         carried = None

@@ -64,6 +64,8 @@ class TaskMotionConfig:
     regrasp_spots: list[float] = field(default_factory=lambda: [0.0, 0.5, 1.0])  # [1]
     # p&pIn* place-and-regrasp: where the intermediate pose is tried, in order, as fractions of
     # the way from where the object is (0) to the place target (1)
+    regrasp_max_poses: int = 16  # p&pIn* place-and-regrasp: intermediate poses examined (the
+    # second leg's reach checked) at most, before giving up
     regrasp_max_legs: int = 3  # p&pIn* place-and-regrasp: intermediate poses whose second leg
     # is reachable that the first leg's full motion planning is tried for, before giving up
 
@@ -78,6 +80,7 @@ class TaskMotionConfig:
                   ("fill_settle", self.fill_settle >= 0.0, ">= 0 s"),
                   ("regrasp_spots", all(0.0 <= f <= 1.0 for f in self.regrasp_spots),
                    "fractions in [0, 1]"),
+                  ("regrasp_max_poses", self.regrasp_max_poses >= 1, ">= 1"),
                   ("regrasp_max_legs", self.regrasp_max_legs >= 1, ">= 1"))
         for name, ok, allowed in checks:
             if not ok:
@@ -227,6 +230,7 @@ class TaskPlacing:
     # turned into `pose` by the grasp's wrist turns
     regrasp_yaws: tuple = ()  # [rad] (TaskMotionConfig.regrasp_yaws)
     regrasp_spots: tuple = (0.0,)  # [1] (TaskMotionConfig)
+    regrasp_max_poses: int = 16  # (TaskMotionConfig)
     regrasp_max_legs: int = 3  # (TaskMotionConfig)
 
     @property
@@ -291,6 +295,7 @@ def task_placing(task: str, *, place_xy, table_z: float, surface: Surface | None
                        turned_release_heights=tuple(config.turned_release_heights),
                        regrasp_yaws=tuple(float(v) for v in np.deg2rad(config.regrasp_yaws)),
                        regrasp_spots=tuple(float(f) for f in config.regrasp_spots),
+                       regrasp_max_poses=int(config.regrasp_max_poses),
                        regrasp_max_legs=int(config.regrasp_max_legs), **pour)
 
 
