@@ -23,7 +23,9 @@ Wiring (docs/design.md, "The diagram"):
     scene_description, ranked_grasps, iiwa.state, plan_request ─▶ planner ─▶ iiwa.desired_state,
         wsg.position, plan_status
     scene_description, grasp_semantics, ranked_grasps, plan_status, wsg.state, body_poses,
-        contact_results ─▶ supervisor ─▶ collisions (─▶ logic), plan_request (─▶ planner), outcome
+        contact_results, perception_status ─▶ supervisor ─▶ collisions (─▶ logic), plan_request
+        (─▶ planner), outcome, perception_request (─▶ perception: look again after a
+        place-and-regrasp leg), target_xy (─▶ target)
     a pass (tg_drake.receiver): grasp_semantics ─▶ planner (the receiver's part); plan_status,
         body_poses ─▶ receiver_driver ─▶ receiver.mount, receiver.position; receiver.state ─▶
         supervisor
@@ -40,7 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.framework import DiagramBuilder, EventStatus, LeafSystem
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.grasping.model import load_model
@@ -55,7 +57,12 @@ from tg_drake.systems.feasibility_system import GraspFeasibility
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.kernel_prior_system import KernelPriorSystem
 from tg_drake.systems.logic_system import LogicQuerySystem, TaskSource
-from tg_drake.systems.perception_system import GroundTruthPerception, PerceptionSystem
+from tg_drake.systems.perception_system import (
+    REQUEST_OFFSET,
+    REQUEST_PERIOD,
+    GroundTruthPerception,
+    PerceptionSystem,
+)
 from tg_drake.systems.supervisor import MonitorModel, Supervisor
 from tg_drake.table import surface_body_name
 from tg_drake.targeting import select_target
@@ -72,22 +79,43 @@ class TargetSelector(LeafSystem):
         name: TargetSelector
         input_ports:
         - scene_description
+        - target_xy (optional)
         output_ports:
         - scene_description
+
+    ``target_xy`` (tuple: () or a world xy [m], the supervisor's): where a place-and-regrasp leg
+    put the target. The hint is latched state: a periodic event at perception's looks
+    (`REQUEST_PERIOD`, `REQUEST_OFFSET`: off the plant's step grid) replaces it by a new
+    ``target_xy``, so the output, and every cache downstream, depends on the scene and the latch
+    only, never on the supervisor's changing state.
     """
 
     def __init__(self, p_W_hint):
         super().__init__()
-        self._hint = np.asarray(p_W_hint, float)
         model = AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4)))
         self._in = self.DeclareAbstractInputPort("scene_description", model)
+        self._moved = self.DeclareAbstractInputPort("target_xy", AbstractValue.Make(()))
+        self._hint = self.DeclareAbstractState(AbstractValue.Make(
+            tuple(float(v) for v in np.asarray(p_W_hint, float)[:2])))
+        self.DeclarePeriodicUnrestrictedUpdateEvent(REQUEST_PERIOD, REQUEST_OFFSET, self._look)
         self.DeclareAbstractOutputPort(
             "scene_description", lambda: AbstractValue.Make(
                 SceneDescription(objects=[], X_WT=np.eye(4))), self._calc,
-            prerequisites_of_calc={self.input_port_ticket(self._in.get_index())})
+            prerequisites_of_calc={self.input_port_ticket(self._in.get_index()),
+                                   self.abstract_state_ticket(self._hint)})
+
+    def _look(self, context, state):
+        if not self._moved.HasValue(context):
+            return EventStatus.DidNothing()
+        moved = tuple(float(v) for v in self._moved.Eval(context))
+        if not moved or moved == context.get_abstract_state(self._hint).get_value():
+            return EventStatus.DidNothing()
+        state.get_mutable_abstract_state(self._hint).set_value(moved)
+        return EventStatus.Succeeded()
 
     def _calc(self, context, output):
-        output.set_value(select_target(self._in.Eval(context), self._hint))
+        hint = np.asarray(context.get_abstract_state(self._hint).get_value(), float)
+        output.set_value(select_target(self._in.Eval(context), hint))
 
 
 @dataclass
@@ -165,11 +193,16 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
             X_WT=scenario.X_WT.GetDeterministicValue(),
             poses=[p.pose for p in scenario.objects],
             containments=[p.containment for p in scenario.objects],
-            spacing=config.perception.spacing, seed=scenario.random_seed))
+            spacing=config.perception.spacing, seed=scenario.random_seed,
+            body_indices=[int(station.object_body(p.instance_name).index())
+                          for p in scenario.objects]))
+        # Looking again (after a place-and-regrasp leg) describes the objects where they are.
+        builder.Connect(station.outputs["body_poses"], perception.GetInputPort("body_poses"))
     # The user points at the target's middle (its box centre; its frame's origin is at its base).
     target = builder.AddNamedSystem("target", TargetSelector(
         X_WO_target.multiply(box_centre(target_placement.id))))
-    builder.Connect(perception.GetOutputPort("scene_description"), target.get_input_port())
+    builder.Connect(perception.GetOutputPort("scene_description"),
+                    target.GetInputPort("scene_description"))
     scene = target.get_output_port()
 
     # Category prior, logic, grasp scoring.
@@ -272,6 +305,13 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     builder.Connect(supervisor.GetOutputPort("collisions"), logic.GetInputPort("collisions"))
     builder.Connect(supervisor.GetOutputPort("no_hold"), logic.GetInputPort("no_hold"))
     builder.Connect(supervisor.GetOutputPort("plan_request"), planner.GetInputPort("plan_request"))
+    # Legs (place-and-regrasp): the supervisor asks perception to look again, waits for the new
+    # latch, and tells the target selector where the target was put.
+    builder.Connect(supervisor.GetOutputPort("perception_request"),
+                    perception.GetInputPort("perception_request"))
+    builder.Connect(perception.GetOutputPort("perception_status"),
+                    supervisor.GetInputPort("perception_status"))
+    builder.Connect(supervisor.GetOutputPort("target_xy"), target.GetInputPort("target_xy"))
 
     ports = {"scene_description": scene,
              "category_prior": prior.GetOutputPort("category_prior"),

@@ -86,7 +86,8 @@ def evaluate_stages(pipeline, context, timings: dict, *, rgb: bool = False) -> S
 def final_stages(pipeline, context, stages: Stages, outcome) -> Stages:
     """The logic's and the scorer's values the planner used last: after re-queries the ones at
     the end of the run (the collision evidence changed them), else those of the start."""
-    if not outcome.requeries or stages.semantics is None:
+    # After place-and-regrasp legs, the final leg's stages (perception looked again).
+    if not (outcome.requeries or outcome.legs) or stages.semantics is None:
         return stages
     final = Stages(scene=stages.scene, prior=stages.prior, rgb=stages.rgb,
                    warnings=list(stages.warnings))
@@ -365,6 +366,12 @@ def summary(result: dict) -> str:
         task = result["task_outcome"]
         lines.append(f"task check {task['task']} {'succeeded' if task['success'] else 'failed'}: "
                      f"{task['detail']}")
+    if o.get("legs"):  # place-and-regrasp legs (and retried grasps) before the final one
+        lines.append(f"legs       {len(o['legs']) + 1}: " + "; ".join(
+            (f"put down {leg['placed_pose']} at ({leg['xy'][0]:.3f}, {leg['xy'][1]:.3f}) m "
+             f"by its {leg['part']}" if leg["ended"] == "placed" else
+             f"{leg['ended']} by its {leg['part']}")
+            + ", looked again" for leg in o["legs"]) + ", then the final leg")
     if o["unreachable_parts"]:
         lines.append(f"closed loop: unreachable parts {o['unreachable_parts']} became "
                      f"collision evidence; {o['requeries']} "

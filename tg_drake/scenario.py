@@ -294,6 +294,11 @@ class SupervisorConfig:
     # the first check at or after the plan's key time)
     min_rise_ratio: float = 0.5  # [1] during the lift the object must rise at least this share
     # of the gripper's rise, else it slipped
+    max_regrasps: int = 1  # place-and-regrasp legs (p&pIn*: the object put down in an
+    # intermediate pose, perceived again and picked again) allowed before the final leg
+    max_retries: int = 0  # after a missed grasp or a failed lift: look again (every plan then
+    # ends with the arm back at its start) and plan again from the new scene, at most this many
+    # times (0: off, the run ends missed / slipped)
 
     def validate(self, where: str = "pipeline.supervisor") -> None:
         checks = (("min_grasp_probability", 0.0 <= self.min_grasp_probability <= 1.0, "in [0, 1]"),
@@ -301,7 +306,9 @@ class SupervisorConfig:
                   ("planning_start", self.planning_start >= 0.0, ">= 0 s"),
                   ("planning_timeout", self.planning_timeout > 0.0, "> 0 s"),
                   ("period", self.period > 0.0, "> 0 s"),
-                  ("min_rise_ratio", 0.0 <= self.min_rise_ratio <= 1.0, "in [0, 1]"))
+                  ("min_rise_ratio", 0.0 <= self.min_rise_ratio <= 1.0, "in [0, 1]"),
+                  ("max_regrasps", self.max_regrasps >= 0, ">= 0"),
+                  ("max_retries", self.max_retries >= 0, ">= 0"))
         for name, ok, allowed in checks:
             if not ok:
                 raise ScenarioError(f"must be {allowed}, got {getattr(self, name)}",

@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from pydrake.math import RigidTransform
+from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.sensors import CameraInfo, ImageDepth32F
 
 from tg_drake.errors import PerceptionError
-from tg_drake.objects import get_object
+from tg_drake.objects import box_centre, get_object
 from tg_drake.perception import synthetic as S
 from tg_drake.perception.geometry import Intrinsics, make_transform
 from tg_drake.systems.perception_system import GroundTruthPerception, PerceptionSystem
@@ -198,3 +198,24 @@ def test_ground_truth_perception_from_library_labels():
     assert len(a.pregrasp_X_WG) == 12 * len(a.part_boxes)
     with pytest.raises(PerceptionError, match="2 object ids but 1 poses"):
         GroundTruthPerception(["cup_01", "hammer_01"], [X_WO])
+
+
+def test_ground_truth_looks_again_where_the_bodies_are_now():
+    """A request after the first, with body_poses connected, describes the object at its body's
+    pose now (a place-and-regrasp moved it), its pose label derived from it."""
+    X_up = RigidTransform([0.8, 0.0, 0.0])
+    system = GroundTruthPerception(["bottle_01"], [X_up], poses=["upright"], body_indices=[1])
+    context = system.CreateDefaultContext()
+    X_lying = RigidTransform(RotationMatrix.MakeYRotation(np.pi / 2), [0.7, -0.1, 0.036])
+    system.GetInputPort("body_poses").FixValue(context, [RigidTransform(), X_lying])
+    system.get_perception_request_input_port().FixValue(context, 0)
+    simulator = Simulator(system, context)
+    simulator.Initialize()
+    first = system.get_scene_description_output_port().Eval(context).objects[0]
+    assert first.pose == "upright" and np.allclose(first.X_WO[:2, 3], [0.8, 0.0], atol=0.02)
+    system.get_perception_request_input_port().FixValue(context, 1)
+    simulator.AdvanceTo(0.1)
+    again = system.get_scene_description_output_port().Eval(context).objects[0]
+    assert system.get_perception_status_output_port().Eval(context).request == 1
+    assert again.pose == "sideways"
+    assert np.allclose(again.X_WO[:3, 3], X_lying.multiply(box_centre("bottle_01")), atol=0.01)

@@ -17,21 +17,25 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource
 
+import tg_drake.systems.supervisor as supervisor_module
 from tg_drake.outcome import HandGeometries
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
 from tg_drake.systems.supervisor import (
     MonitorModel,
     Outcome,
+    Phase,
     Reason,
     Status,
     Supervisor,
     SupervisorConfig,
+    _Memory,
 )
 from tg_drake.types import (
     PART_LABELS,
     GraspCandidates,
     GraspSemantics,
+    PerceptionStatus,
     SceneDescription,
 )
 
@@ -339,3 +343,98 @@ def test_closed_loop_stops_when_the_logic_vetoes_after_the_requery():
     assert (outcome.status, outcome.reason) == ("failed", "unreachable")
     assert "P(some part is grasped) = 0.010" in outcome.detail
     assert (status.status, status.attempt) == ("failed", 1)  # the top was never planned
+
+
+def test_a_regrasp_leg_then_perception_looks_again_and_the_final_leg_is_the_runs(monkeypatch):
+    """The legs (place-and-regrasp) with a stub plan and a stub perception status: the first
+    leg's plan ends placed, the supervisor asks perception to look again (perception_request 1),
+    waits for the new latch, runs the gate, asks for the next leg (no regrasp allowed any more:
+    max_regrasps 1) and judges the final leg's task; the outcome records the leg."""
+    held = iter([True, True, False] * 2)  # closed, lifted, let go: leg 1, then the final leg
+    monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: SimpleNamespace(
+        held=next(held), opening=0.05, left=True, right=True))
+    monkeypatch.setattr(supervisor_module, "touches_table", lambda *a, **k: True)
+    monkeypatch.setattr(supervisor_module, "placed", lambda *a, **k: (True, "placed 0.3 cm"))
+    f = Fixed(task="p&pInUpright",
+              config=SupervisorConfig(planning_start=0.0, period=0.01, planning_timeout=0.5))
+    look = f.supervisor.get_perception_status_input_port()
+    look.FixValue(f.context, PerceptionStatus(ok=True, request=0))
+    looks = f.supervisor.get_perception_request_output_port()
+    f.advance(0.001)
+    assert f.request == PlanRequest(attempt=1, regrasp=True) and looks.Eval(f.context) == 0
+
+    X_intermediate = np.eye(4)
+    X_intermediate[:2, 3] = [0.8, -0.1]
+    leg = SimpleNamespace(regrasp=True, t_grasp_closed=0.1, t_lift_done=0.2, duration=0.3,
+                          t_pour=None, R_turn=None, X_WO_place=X_intermediate)
+    f.plan(PlanStatus(PlanState.executing, attempt=1, part="middle", t_plan=0.01, plan=leg))
+    f.advance(0.35)
+    o = f.outcome
+    assert not o.final and "waiting for perception to look again" in o.detail
+    assert looks.Eval(f.context) == 1
+    assert f.supervisor.get_target_xy_output_port().Eval(f.context) == (0.8, -0.1)
+    assert [dict(x)["part"] for x in o.legs] == ["middle"]
+    assert dict(o.legs[0])["placed_pose"] == "upright"  # body pose identity: upright
+    f.advance(0.45)
+    assert f.request.attempt == 1  # still looking: the latch serves request 0
+
+    look.FixValue(f.context, PerceptionStatus(ok=True, request=1))
+    f.advance(0.48)
+    assert f.request == PlanRequest(attempt=2, regrasp=False)  # the bound: one regrasp leg
+    final = SimpleNamespace(regrasp=False, t_grasp_closed=0.1, t_lift_done=0.2, duration=0.3,
+                            t_pour=None, R_turn=None, X_WO_place=np.eye(4))
+    f.plan(PlanStatus(PlanState.executing, attempt=2, part="middle", t_plan=0.48, plan=final))
+    f.advance(0.9)
+    o = f.outcome
+    assert (o.status, o.final) == ("placed", True)
+    assert o.task_outcome.success and o.task_outcome.measure["rest_pose"] == "upright"
+    assert o.as_dict()["legs"] == [{"part": "middle", "ended": "placed",
+                                    "placed_pose": "upright", "xy": [0.8, -0.1], "t_end": 0.31}]
+
+
+def test_when_the_regrasp_bound_is_reached_the_failure_says_so():
+    f = Fixed(task="p&pInUpright")
+    leg = (("part", "middle"), ("ended", "placed"), ("placed_pose", "sideways"),
+           ("xy", [0.8, 0.0]), ("t_end", 1.0))
+    f.context.get_mutable_abstract_state(0).set_value(
+        _Memory(phase=Phase.planning, attempt=2, legs=(leg,), t_leg=0.0))
+    f.plan(failed(2, None, reason="the object can be picked but not placed: ..., the object "
+                  "turned to rest upright in the hand (no place-and-regrasp leg allowed: "
+                  "pipeline.supervisor.max_regrasps)"))
+    f.advance(0.011)
+    o = f.outcome
+    assert (o.status, o.reason, len(o.legs)) == ("failed", "unreachable", 1)
+    assert o.detail.startswith("after 1 place-and-regrasp leg(s) (max_regrasps = 1)")
+    assert "no place-and-regrasp leg allowed" in o.detail and not o.task_outcome.success
+
+
+def test_with_retries_a_missed_grasp_is_looked_at_again_once_its_plan_is_over(monkeypatch):
+    """max_retries 1: plans end with the arm home (return_home); the missed grasp is recorded,
+    perception asked to look only once the plan is over, then the next attempt is requested
+    (return_home off: no retry left); a second miss ends the run, saying so."""
+    monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: SimpleNamespace(
+        held=False, opening=0.0, left=False, right=False))
+    f = Fixed(config=SupervisorConfig(planning_start=0.0, period=0.01, planning_timeout=0.5,
+                                      max_retries=1))
+    look = f.supervisor.get_perception_status_input_port()
+    look.FixValue(f.context, PerceptionStatus(ok=True, request=0))
+    looks = f.supervisor.get_perception_request_output_port()
+    f.advance(0.001)
+    assert f.request == PlanRequest(attempt=1, return_home=True)
+    plan = SimpleNamespace(regrasp=False, t_grasp_closed=0.1, t_lift_done=0.2, duration=0.6,
+                           t_pour=None, R_turn=None, X_WO_place=np.eye(4))
+    f.plan(PlanStatus(PlanState.executing, attempt=1, part="top", t_plan=0.01, plan=plan))
+    f.advance(0.15)  # the miss
+    o = f.outcome
+    assert not o.final and [dict(x)["ended"] for x in o.legs] == ["missed"]
+    assert looks.Eval(f.context) == 0  # the arm is still on its way home
+    f.advance(0.62)
+    assert looks.Eval(f.context) == 1 and f.request.attempt == 1
+    look.FixValue(f.context, PerceptionStatus(ok=True, request=1))
+    f.advance(0.65)
+    assert f.request == PlanRequest(attempt=2, return_home=False)
+    f.plan(PlanStatus(PlanState.executing, attempt=2, part="top", t_plan=0.65, plan=plan))
+    f.advance(0.8)
+    o = f.outcome
+    assert (o.status, o.reason, len(o.legs)) == ("failed", "missed", 1)
+    assert o.detail.startswith("after 1 retried grasp(s) (max_retries = 1): fingers closed")

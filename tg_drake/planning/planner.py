@@ -170,6 +170,9 @@ class Plan:
     # no hand-over
     handover: object | None = None  # pass: the receiver's motion (planning.handover.
     # HandoverMotion, its grasp and part), in plan time; None: no hand-over
+    regrasp: bool = False  # the plan ends with the object placed in an intermediate resting pose
+    # and the arm back at its start (out of the camera's view): a place-and-regrasp's first leg
+    # (tg_drake.planning.regrasp); the supervisor looks again and plans the next leg
 
     def q(self, t: float) -> np.ndarray:
         """(7,) joint positions at plan time t (held at the ends outside [0, duration])."""
@@ -362,8 +365,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             if "pre-grasp" in poses:
                 part_reachable[part] = True
             if failure and R_turn is not None and failure.startswith(PLACE_FAILURES):
-                failure += (f", the object turned to rest {placing.pose} in the hand "
-                            "(a place-and-regrasp is not implemented)")
+                failure += f", {TURNED_IN_HAND} {placing.pose} in the hand"
             if failure.startswith(POUR_FAILURES):  # another pour may do
                 failed_pours.add(k_pour)
             if failure:
@@ -380,8 +382,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                                                   receiving=receiving)
             part_pickable[part] |= picked
             if plan is None and R_turn is not None and failure.startswith(PLACE_FAILURES):
-                failure += (f", the object turned to rest {placing.pose} in the hand "
-                            "(a place-and-regrasp is not implemented)")
+                failure += f", {TURNED_IN_HAND} {placing.pose} in the hand"
             if plan is None:
                 if failure.startswith(POUR_FAILURES):
                     failed_pours.add(k_pour)
@@ -518,6 +519,10 @@ def target_shapes(target: ObjectDescription) -> list[tuple]:
             shapes.append((f"target_{name}", RigidTransform(X_WB), tuple(size)))
     return shapes
 
+
+# How a place failure of an object turned into the task's resting pose in the hand ends (the
+# place-and-regrasp of tg_drake.planning.regrasp.plan_task_leg looks for it).
+TURNED_IN_HAND = "the object turned to rest"
 
 # The key poses and motions of the pick; failures after them are the place's.
 PICK_POSES = {"pre-grasp", "grasp", "lift"}

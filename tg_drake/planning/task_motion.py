@@ -58,6 +58,16 @@ class TaskMotionConfig:
     fill_clearance: float = 0.02  # [m] pourIn: the container's box under the dispenser's gate
     fill_open: float = 1.5  # [s] pourIn: the dispenser is open while the container is held
     fill_settle: float = 1.0  # [s] pourIn: held on after the dispenser closes
+    regrasp_yaws: list[float] = field(default_factory=lambda: [90.0, -90.0, 180.0, 45.0, -45.0])
+    # [deg] p&pIn* place-and-regrasp: turns of the object about the vertical tried for the
+    # intermediate resting pose, in order (tg_drake.planning.regrasp)
+    regrasp_spots: list[float] = field(default_factory=lambda: [0.0, 0.5, 1.0])  # [1]
+    # p&pIn* place-and-regrasp: where the intermediate pose is tried, in order, as fractions of
+    # the way from where the object is (0) to the place target (1)
+    regrasp_max_poses: int = 16  # p&pIn* place-and-regrasp: intermediate poses examined (the
+    # second leg's reach checked) at most, before giving up
+    regrasp_max_legs: int = 3  # p&pIn* place-and-regrasp: intermediate poses whose second leg
+    # is reachable that the first leg's full motion planning is tried for, before giving up
 
     def validate(self, where: str = "pipeline.tasks") -> None:
         checks = (("turned_release_heights", all(h >= 0.0 for h in self.turned_release_heights)
@@ -67,7 +77,11 @@ class TaskMotionConfig:
                   ("pour_clearance", self.pour_clearance >= 0.0, ">= 0 m"),
                   ("fill_clearance", self.fill_clearance >= 0.0, ">= 0 m"),
                   ("fill_open", self.fill_open > 0.0, "> 0 s"),
-                  ("fill_settle", self.fill_settle >= 0.0, ">= 0 s"))
+                  ("fill_settle", self.fill_settle >= 0.0, ">= 0 s"),
+                  ("regrasp_spots", all(0.0 <= f <= 1.0 for f in self.regrasp_spots),
+                   "fractions in [0, 1]"),
+                  ("regrasp_max_poses", self.regrasp_max_poses >= 1, ">= 1"),
+                  ("regrasp_max_legs", self.regrasp_max_legs >= 1, ">= 1"))
         for name, ok, allowed in checks:
             if not ok:
                 raise ScenarioError(f"must be {allowed}, got {getattr(self, name)}",
@@ -137,6 +151,14 @@ def turns_to_pose(R_WO: np.ndarray, R_WG: np.ndarray, pose: str, *, is_tool: boo
     return unique
 
 
+def smallest_turn(R_WO: np.ndarray, pose: str, *, is_tool: bool) -> np.ndarray | None:
+    """The world rotation that turns an object of orientation R_WO into resting pose `pose` by
+    the smallest tip-over, whatever holds it (I when it rests so already); None when it cannot
+    rest so (`turns_to_pose`)."""
+    turns = turns_to_pose(R_WO, np.eye(3), pose, is_tool=is_tool)
+    return turns[-1] if turns else None
+
+
 def turned_retreat(y_WG: np.ndarray) -> np.ndarray:
     """The unit direction a gripper backs away in after releasing an object it turned: back along
     its approach (−y_G), but never down (a turned object's approach may point up, and backing
@@ -203,6 +225,13 @@ class TaskPlacing:
     fill_clearance: float = 0.02  # [m]
     fill_open: float = 1.5  # [s]
     fill_settle: float = 1.0  # [s]
+    R_place: tuple | None = None  # 3×3 (nested tuples): the object's exact world orientation at
+    # release (a place-and-regrasp's intermediate resting pose, tg_drake.planning.regrasp); None:
+    # turned into `pose` by the grasp's wrist turns
+    regrasp_yaws: tuple = ()  # [rad] (TaskMotionConfig.regrasp_yaws)
+    regrasp_spots: tuple = (0.0,)  # [1] (TaskMotionConfig)
+    regrasp_max_poses: int = 16  # (TaskMotionConfig)
+    regrasp_max_legs: int = 3  # (TaskMotionConfig)
 
     @property
     def hold(self) -> float:
@@ -215,6 +244,14 @@ class TaskPlacing:
         object cannot be turned into the pose. `place_pose` is the planner's
         (`tg_drake.planning.planner.place_pose`)."""
         X_WO = np.asarray(X_WO, float)
+        if self.R_place is not None:  # an exact orientation: one turn, each release height
+            R = np.asarray(self.R_place, float) @ X_WO[:3, :3].T
+            if np.allclose(R, np.eye(3), atol=1e-9):
+                return [(None, place_pose(X_WO, extents, self.place_xy, table_z=self.support_z,
+                                          release_height=release_height))]
+            return [(R, place_pose(turned(X_WO, R), extents, self.place_xy,
+                                   table_z=self.support_z, release_height=height))
+                    for height in self.turned_release_heights]
         if self.pose is None:
             return [(None, place_pose(X_WO, extents, self.place_xy, table_z=self.support_z,
                                       release_height=release_height))]
@@ -255,7 +292,11 @@ def task_placing(task: str, *, place_xy, table_z: float, surface: Surface | None
                     fill_open=float(config.fill_open), fill_settle=float(config.fill_settle),
                     pour_yaws=tuple(float(v) for v in np.deg2rad(config.pour_yaws)))
     return TaskPlacing(task, pose, tuple(float(v) for v in place_xy), float(table_z),
-                       turned_release_heights=tuple(config.turned_release_heights), **pour)
+                       turned_release_heights=tuple(config.turned_release_heights),
+                       regrasp_yaws=tuple(float(v) for v in np.deg2rad(config.regrasp_yaws)),
+                       regrasp_spots=tuple(float(f) for f in config.regrasp_spots),
+                       regrasp_max_poses=int(config.regrasp_max_poses),
+                       regrasp_max_legs=int(config.regrasp_max_legs), **pour)
 
 
 def bowl_of(obstacles, pour_at) -> int | None:

@@ -17,7 +17,8 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
-from tg_drake.planning.planner import PlannerConfig, PlanResult, plan_for_scene
+from tg_drake.planning.planner import PlannerConfig, PlanResult
+from tg_drake.planning.regrasp import plan_task_leg
 from tg_drake.planning.task_motion import TaskPlacing
 from tg_drake.robot import IIWA_HOME
 from tg_drake.scenario import Scenario
@@ -73,7 +74,10 @@ class GraspPlanner(LeafSystem):
     (its candidates best first; `tg_drake.planning.planner.plan_pick_and_place` with one part).
     Once a plan exists, ``iiwa.desired_state`` (q, v) and ``wsg.position`` (opening width [m];
     closing is commanded as width `PlannerConfig.closed_width`, the WSG driver's force limit sets
-    the grip) follow it in time from the event at which it was made; later requests are ignored.
+    the grip) follow it in time from the event at which it was made; a later request is planned
+    once the plan is over, from its end posture (the supervisor's next leg: after a
+    place-and-regrasp's first leg, `Plan.regrasp`, allowed by `PlanRequest.regrasp`, or after a
+    missed grasp, with `PlanRequest.return_home`).
 
     ``plan_status`` is a `PlanStatus` (from state and time only: feeding it to a supervisor whose
     outputs feed the logic makes no algebraic loop): planning, executing, done or failed,
@@ -173,8 +177,16 @@ class GraspPlanner(LeafSystem):
     def _plan(self, context, state):
         memory: _Memory = context.get_abstract_state(self._memory).get_value()
         request = self._request(context)
-        if memory.result is not None or request.attempt <= memory.attempt:
+        if request.attempt <= memory.attempt:
             return EventStatus.DidNothing()
+        if memory.result is not None:
+            # A plan that is over lets the next request (the supervisor's next leg) be planned,
+            # from where it left the arm; until then the plan is followed.
+            plan = memory.result.plan
+            if context.get_time() - memory.t_plan < plan.duration:
+                return EventStatus.DidNothing()
+            memory = dataclasses.replace(memory, q_hold=plan.q(plan.duration), result=None,
+                                         t_plan=None)
         scene: SceneDescription = self._scene_port.Eval(context)
         grasps: GraspCandidates = self._grasps_port.Eval(context)
         t0 = time.perf_counter()
@@ -187,13 +199,15 @@ class GraspPlanner(LeafSystem):
         else:
             semantics = (self._semantics_port.Eval(context)
                          if self._semantics_port.HasValue(context) else None)
-            result = plan_for_scene(scene, grasps, place_xy=self._place_xy,
-                                    q_start=memory.q_hold, config=self._config,
-                                    scenario=self._scenario,
-                                    exclude_parts=tuple(request.exclude_parts), max_parts=1,
-                                    placing=self._placing, surfaces=self._surfaces,
-                                    handover=self._handover,
-                                    category=semantics.category if semantics else None)
+            result = plan_task_leg(scene, grasps, place_xy=self._place_xy,
+                                   q_start=memory.q_hold, config=self._config,
+                                   scenario=self._scenario,
+                                   exclude_parts=tuple(request.exclude_parts), max_parts=1,
+                                   placing=self._placing, surfaces=self._surfaces,
+                                   handover=self._handover,
+                                   category=semantics.category if semantics else None,
+                                   regrasp=request.regrasp,
+                                   return_home=request.return_home)
             if result.status == "planned":
                 memory = dataclasses.replace(memory, result=result, t_plan=context.get_time())
             else:

@@ -225,6 +225,7 @@ class GroundTruthPerception(_LatchedPerception):
         name: GroundTruthPerception
         input_ports:
         - perception_request (optional)
+        - body_poses (optional)
         output_ports:
         - scene_description
         - perception_status
@@ -233,12 +234,15 @@ class GroundTruthPerception(_LatchedPerception):
     labels and outward normals, at its world pose X_WO (the library object frame); its pose
     label is given or derived from X_WO, its parts have probability 1. The description is made
     once, when the system is built, and latched like `PerceptionSystem`'s (at initialization and
-    on a ``perception_request``), with the same ``perception_status``. For the synthetic
-    evaluation only: the pipeline's `PerceptionSystem` never reads ground truth.
+    on a ``perception_request``), with the same ``perception_status``. A request after the first
+    (a value > 0) with ``body_poses`` connected (the plant's body poses; `body_indices` gives
+    each object's body) describes the objects where they are now, their pose labels derived from
+    those poses (a place-and-regrasp moved the target). For the synthetic evaluation only: the
+    pipeline's `PerceptionSystem` never reads ground truth.
     """
 
     def __init__(self, object_ids: list[str], X_WO: list, *, X_WT=None, poses=None,
-                 containments=None, spacing: float = 0.004, seed: int = 0):
+                 containments=None, spacing: float = 0.004, seed: int = 0, body_indices=None):
         super().__init__()
         if len(object_ids) != len(X_WO):
             raise PerceptionError(
@@ -246,6 +250,11 @@ class GroundTruthPerception(_LatchedPerception):
         X_WT = np.eye(4) if X_WT is None else _matrix(X_WT)
         poses = poses if poses is not None else [None] * len(object_ids)
         containments = containments if containments is not None else [None] * len(object_ids)
+        self._ids, self._X_WT, self._spacing, self._seed = list(object_ids), X_WT, spacing, seed
+        self._containments = list(containments)
+        self._bodies = None if body_indices is None else [int(i) for i in body_indices]
+        self._poses_port = self.DeclareAbstractInputPort(
+            "body_poses", AbstractValue.Make([RigidTransform()]))
         rng = np.random.default_rng(seed)
         self._scene = SceneDescription(objects=[
             describe_library_object(i, _matrix(X), X_WT, spacing=spacing, rng=rng, pose=p,
@@ -254,7 +263,16 @@ class GroundTruthPerception(_LatchedPerception):
         self._declare_latch()
 
     def _perceive(self, context) -> SceneDescription:
-        return self._scene
+        request = self._request(context)
+        if request == 0 or self._bodies is None or not self._poses_port.HasValue(context):
+            return self._scene
+        poses = self._poses_port.Eval(context)  # where the objects are now
+        rng = np.random.default_rng(self._seed + request)
+        return SceneDescription(objects=[
+            describe_library_object(i, _matrix(poses[b]), self._X_WT, spacing=self._spacing,
+                                    rng=rng, containment=c)
+            for i, b, c in zip(self._ids, self._bodies, self._containments, strict=True)],
+            X_WT=self._X_WT)
 
 
 def _matrix(X) -> np.ndarray:

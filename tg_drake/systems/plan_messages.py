@@ -32,6 +32,10 @@ class PlanRequest:
 
     attempt: int = 0
     exclude_parts: tuple = ()
+    regrasp: bool = False  # a place-and-regrasp's first leg may be planned (p&pIn*: the object
+    # put down in an intermediate pose, `Plan.regrasp`), when the task's turn cannot be placed
+    return_home: bool = False  # the plan ends with the arm back at its start configuration (out
+    # of the camera's view), so that perception can look again after a missed grasp or lift
 
 
 @dataclass(frozen=True)

@@ -19,6 +19,18 @@ every decision that spans stages is taken here, in simulated time, from port val
    (`tg_drake.tasks.judge`) on the object's simulated pose, its contacts and the contents'
    counts gives `Outcome.task_outcome`; a run that ended before the end of its plan gets a failed
    task outcome saying why.
+5. **Legs** (place-and-regrasp, p&pIn*): for a given p&pIn* task, while fewer than
+   `SupervisorConfig.max_regrasps` legs are done, a plan request allows a first leg
+   (`PlanRequest.regrasp`). A plan that ends with the object put down in an intermediate pose
+   (`Plan.regrasp`) is monitored like any other; placed,
+   the leg is recorded (`Outcome.legs`), the supervisor asks perception to look again (the
+   ``perception_request`` counter), waits for the new latch (``perception_status.request``),
+   then runs the gate and asks for the next leg's plan from the new scene, with the same task.
+   The final leg's outcome and task outcome are the run's.
+6. **Retries** (`SupervisorConfig.max_retries`, 0 = off): while retries are left, every plan
+   ends with the arm back at its start (`PlanRequest.return_home`); a missed grasp or a failed
+   lift is then recorded as a leg, and once that plan is over, perception looks again and the
+   next leg is planned from the new scene instead of ending the run.
 """
 
 
@@ -56,9 +68,10 @@ from tg_drake.tasks.judge import (
     judge_pass,
     judge_pour,
     judge_rest_pose,
+    rest_pose,
 )
 from tg_drake.tasks.outcome import TaskOutcome
-from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
+from tg_drake.types import GraspCandidates, GraspSemantics, PerceptionStatus, SceneDescription
 
 
 class Status(enum.StrEnum):
@@ -109,6 +122,8 @@ class Outcome:
     unreachable_parts: tuple = ()  # parts given to the logic as collision(Part) evidence
     requeries: int = 0  # how often the logic was asked again with new collision evidence
     task_outcome: TaskOutcome | None = None  # the task's physical check (None: no task given)
+    legs: tuple = ()  # the legs done before the final one (place-and-regrasp, retries): a dict
+    # each (part, ended: placed / missed / slipped, placed_pose, xy [m] or None, t_end [s])
 
     @property
     def final(self) -> bool:
@@ -120,7 +135,8 @@ class Outcome:
                 "reachable_parts": list(self.reachable_parts),
                 "unreachable_parts": list(self.unreachable_parts), "requeries": self.requeries,
                 "task_outcome": (self.task_outcome.as_dict() if self.task_outcome is not None
-                                 else None)}
+                                 else None),
+                "legs": [dict(leg) for leg in self.legs]}
 
 
 def outcome_of_error(error: Exception, *, pending: Outcome | None = None) -> Outcome:
@@ -180,6 +196,7 @@ class Phase(enum.StrEnum):
     gate = "gate"  # the next check runs the gate (at the start, and after a re-query)
     planning = "planning"  # waiting for the planner's answer to the current attempt
     executing = "executing"  # following the plan, monitoring its key times
+    looking = "looking"  # a regrasp leg is placed: waiting for perception to look again
     done = "done"  # the outcome is final
 
 
@@ -203,6 +220,14 @@ class _Memory:
     t_released: float | None = None  # [s] pass: simulated time of the robot's release
     held_at_pour: bool = False  # the gripper held the container at the end of the pour
     outcome: Outcome | None = None  # the final outcome
+    looks: int = 0  # perception_request: how often perception was asked to look again
+    legs: tuple = ()  # Outcome.legs: the regrasp legs done
+    t_leg: float | None = None  # [s] when the current leg's gate began (None: planning_start)
+    target_xy: tuple = ()  # world xy [m] where the last regrasp leg put the target (its box
+    # centre, as planned); () before any
+    retries: int = 0  # legs ended by a missed grasp or a failed lift, looked at again
+    look_after: float | None = None  # [s] ask perception to look once this time has passed (the
+    # end of a plan whose grasp failed)
 
     def __deepcopy__(self, memo):
         return self  # immutable: the simulator's state copies may share it
@@ -222,12 +247,15 @@ class Supervisor(LeafSystem):
         - wsg.state
         - body_poses
         - contact_results
+        - perception_status (optional)
         output_ports:
         - collisions
         - no_hold
         - plan_request
         - outcome
         - dispenser_command
+        - perception_request
+        - target_xy
 
     ``scene_description`` (`SceneDescription`), ``grasp_semantics`` (`GraspSemantics`) and
     ``ranked_grasps`` (`GraspCandidates`) are read at gate checks only; ``plan_status``
@@ -244,6 +272,10 @@ class Supervisor(LeafSystem):
     ``plan_request`` (`PlanRequest`: the attempt to plan and the parts to
     leave out, for the planner) and ``outcome`` (`Outcome`; `Outcome.final` once decided);
     ``dispenser_command`` (1-vector: 1 opens the station's dispenser) on the state and the time.
+    Legs (module doc, 5): ``perception_request`` (int counter, for both perception systems'
+    ``perception_request`` input) grows by one after each regrasp leg; ``perception_status``
+    (`PerceptionStatus`) is read while looking; ``target_xy`` (tuple: () or the world xy where
+    the last regrasp leg put the target) tells the target selector where the target is now.
     """
 
     def __init__(self, *, config: SupervisorConfig | None = None, model: "MonitorModel",
@@ -281,6 +313,8 @@ class Supervisor(LeafSystem):
             "body_poses", AbstractValue.Make([RigidTransform()]))
         self._contacts_port = self.DeclareAbstractInputPort(
             "contact_results", AbstractValue.Make(ContactResults()))
+        self._perception_port = self.DeclareAbstractInputPort(
+            "perception_status", AbstractValue.Make(PerceptionStatus(ok=False)))
 
         self._memory = self.DeclareAbstractState(AbstractValue.Make(_Memory()))
         self.DeclarePeriodicUnrestrictedUpdateEvent(self._config.period,
@@ -302,6 +336,14 @@ class Supervisor(LeafSystem):
         self._dispenser_port = self.DeclareVectorOutputPort(
             "dispenser_command", 1, self._calc_dispenser,
             prerequisites_of_calc=on_state | {self.time_ticket()})
+        self._look_port = self.DeclareAbstractOutputPort(
+            "perception_request", lambda: AbstractValue.Make(0),
+            lambda context, output: output.set_value(self._memory_of(context).looks),
+            prerequisites_of_calc=on_state)
+        self._target_xy_port = self.DeclareAbstractOutputPort(
+            "target_xy", lambda: AbstractValue.Make(()),
+            lambda context, output: output.set_value(self._memory_of(context).target_xy),
+            prerequisites_of_calc=on_state)
 
     @property
     def config(self) -> SupervisorConfig:
@@ -329,6 +371,15 @@ class Supervisor(LeafSystem):
     def get_contact_results_input_port(self):
         return self._contacts_port
 
+    def get_perception_status_input_port(self):
+        return self._perception_port
+
+    def get_perception_request_output_port(self):
+        return self._look_port
+
+    def get_target_xy_output_port(self):
+        return self._target_xy_port
+
     def get_collisions_output_port(self):
         return self._collisions_port
 
@@ -354,6 +405,8 @@ class Supervisor(LeafSystem):
                 new = self._gate(context, memory)
             elif memory.phase is Phase.planning:
                 new = self._await_plan(context, memory)
+            elif memory.phase is Phase.looking:
+                new = self._await_look(context, memory)
             else:
                 new = self._monitor(context, memory)
         except TgDrakeError as e:
@@ -366,6 +419,13 @@ class Supervisor(LeafSystem):
     def _finish(self, memory: _Memory, status: Status, reason: Reason, detail: str,
                 task_outcome: TaskOutcome | None = None, **changes) -> _Memory:
         memory = dataclasses.replace(memory, **changes)
+        if memory.legs and status is Status.failed:
+            regrasps = len(memory.legs) - memory.retries
+            done = ([f"{regrasps} place-and-regrasp leg(s) (max_regrasps = "
+                     f"{self._config.max_regrasps})"] if regrasps else [])
+            done += ([f"{memory.retries} retried grasp(s) (max_retries = "
+                      f"{self._config.max_retries})"] if memory.retries else [])
+            detail = f"after {' and '.join(done)}: {detail}"
         reachable = (memory.status.part,) if memory.status is not None else ()
         if task_outcome is None and self._task:
             why = f"{status}" + (f" ({reason})" if reason else "")
@@ -380,7 +440,7 @@ class Supervisor(LeafSystem):
         return dataclasses.replace(memory, phase=Phase.done, outcome=Outcome(
             status, reason, detail, reachable_parts=reachable,
             unreachable_parts=memory.collisions, requeries=memory.requeries,
-            task_outcome=task_outcome))
+            task_outcome=task_outcome, legs=memory.legs))
 
     def _gate(self, context, memory: _Memory) -> _Memory:
         scene: SceneDescription = self._scene_port.Eval(context)
@@ -427,7 +487,8 @@ class Supervisor(LeafSystem):
                                        X_WO_picked=poses[self._model.object_body])
         if status.attempt >= memory.attempt and status.status is PlanState.failed:
             return self._after_failure(memory, status, self._grasps_port.Eval(context))
-        deadline = self._config.planning_start + self._config.planning_timeout
+        start = self._config.planning_start if memory.t_leg is None else memory.t_leg
+        deadline = start + self._config.planning_timeout
         if context.get_time() >= deadline:
             return self._finish(memory, Status.failed, Reason.timeout,
                                 f"no plan within planning_timeout = "
@@ -480,16 +541,19 @@ class Supervisor(LeafSystem):
         z_G = poses[self._model.gripper_body].translation()[2]
         if memory.checks_passed == 0:  # the gripper has closed
             if not hand.held:
-                return self._finish(
-                    memory, Status.failed, Reason.missed,
-                    f"fingers closed to {hand.opening * 1000:.0f} mm without holding the object "
-                    f"(left pad {hand.left}, right pad {hand.right})")
+                why = (f"fingers closed to {hand.opening * 1000:.0f} mm without holding the "
+                       f"object (left pad {hand.left}, right pad {hand.right})")
+                if memory.retries < self._config.max_retries:
+                    return self._retry(context, memory, plan, X_WO, "missed")
+                return self._finish(memory, Status.failed, Reason.missed, why)
             return dataclasses.replace(memory, checks_passed=1, z_G_grasped=z_G,
                                        z_O_grasped=X_WO.translation()[2])
         if memory.checks_passed == 1:  # the lift is done
             rise = X_WO.translation()[2] - memory.z_O_grasped
             gripper_rise = z_G - memory.z_G_grasped
             if not hand.held or rise < self._config.min_rise_ratio * gripper_rise:
+                if memory.retries < self._config.max_retries:
+                    return self._retry(context, memory, plan, X_WO, "slipped")
                 return self._finish(memory, Status.grasped, Reason.slipped,
                                     f"the object rose {rise * 100:.1f} cm while the gripper rose "
                                     f"{gripper_rise * 100:.1f} cm")
@@ -517,11 +581,73 @@ class Supervisor(LeafSystem):
                 memory.X_WO_picked.translation())
         ok, detail = placed(X_WO_expected, X_WO, plan.X_WO_place[:2, 3],
                             released=on_table and not hand.held, p_OC=self._model.p_OC)
+        if plan.regrasp:
+            return self._after_leg(context, memory, plan, X_WO, ok, detail)
         task = self._task_check(X_WO, plan, contacts, released=not hand.held, poses=poses,
                                 held_at_pour=memory.held_at_pour)
         if ok:
             return self._finish(memory, Status.placed, Reason.none, detail, task)
         return self._finish(memory, Status.lifted, Reason.slipped, detail, task)
+
+    # Legs (place-and-regrasp).
+    def _after_leg(self, context, memory: _Memory, plan, X_WO: RigidTransform, ok: bool,
+                   detail: str) -> _Memory:
+        """A regrasp leg's plan is over: placed, it is recorded and perception is asked to look
+        again; else the run ends as for a plan that did not place."""
+        if not ok:
+            task = (TaskOutcome(self._task, False, {}, "not done: the object was not placed "
+                                f"in its intermediate pose: {detail}") if self._task else None)
+            return self._finish(memory, Status.lifted, Reason.slipped,
+                                f"place-and-regrasp leg {len(memory.legs) + 1}: {detail}", task)
+        xy = tuple(round(float(v), 4) for v in plan.X_WO_place[:2, 3])
+        return dataclasses.replace(self._next_leg(context, memory, X_WO, "placed", xy),
+                                   looks=memory.looks + 1, target_xy=xy)
+
+    def _retry(self, context, memory: _Memory, plan, X_WO: RigidTransform, ended: str
+               ) -> _Memory:
+        """A missed grasp or a failed lift with retries left: recorded as a leg; perception is
+        asked to look again once the plan (which ends with the arm back at its start) is over."""
+        return dataclasses.replace(self._next_leg(context, memory, X_WO, ended, None),
+                                   retries=memory.retries + 1,
+                                   look_after=memory.status.t_plan + plan.duration)
+
+    def _next_leg(self, context, memory: _Memory, X_WO: RigidTransform, ended: str, xy
+                  ) -> _Memory:
+        """The leg that ends now recorded (`Outcome.legs`), the state made ready for the next
+        (a new scene: no collision or no-hold evidence), looking."""
+        leg = (("part", memory.status.part), ("ended", ended),
+               ("placed_pose", rest_pose(X_WO.GetAsMatrix4(), np.array(self._model.X_WT),
+                                         is_tool=self._model.is_tool)),
+               ("xy", None if xy is None else list(xy)),
+               ("t_end", round(float(context.get_time()), 3)))
+        return dataclasses.replace(memory, phase=Phase.looking, legs=memory.legs + (leg,),
+                                   status=None, checks_passed=0, held_at_pour=False,
+                                   collisions=(), no_hold=(), failures=(),
+                                   t_leg=context.get_time())
+
+    def _await_look(self, context, memory: _Memory) -> _Memory:
+        """Waits for perception to serve the latest request, then runs the gate again (after a
+        failed grasp, asks for the look once its plan is over)."""
+        if memory.look_after is not None:
+            if context.get_time() < memory.look_after:
+                return memory
+            memory = dataclasses.replace(memory, looks=memory.looks + 1, look_after=None,
+                                         t_leg=context.get_time())
+        if not self._perception_port.HasValue(context):
+            return self._finish(memory, Status.failed, Reason.perception,
+                                "a leg ended but perception cannot be asked to look again "
+                                "(perception_status is not connected)")
+        status: PerceptionStatus = self._perception_port.Eval(context)
+        if status.request != memory.looks:
+            if context.get_time() >= memory.t_leg + self._config.planning_timeout:
+                return self._finish(memory, Status.failed, Reason.timeout,
+                                    f"perception did not look again within planning_timeout = "
+                                    f"{self._config.planning_timeout} s")
+            return memory
+        if not status.ok:
+            return self._finish(memory, Status.failed, Reason.perception,
+                                f"looking again after a place-and-regrasp leg: {status.error}")
+        return dataclasses.replace(memory, phase=Phase.gate, t_leg=context.get_time())
 
     def _task_check(self, X_WO: RigidTransform, plan, contacts, *, released: bool, poses=(),
                     held_at_pour: bool = False) -> TaskOutcome | None:
@@ -590,7 +716,11 @@ class Supervisor(LeafSystem):
     def _calc_request(self, context, output):
         memory = self._memory_of(context)
         output.set_value(PlanRequest(attempt=memory.attempt,
-                                     exclude_parts=memory.collisions + memory.no_hold))
+                                     exclude_parts=memory.collisions + memory.no_hold,
+                                     regrasp=(self._task in REST_POSE_OF_TASK and len(
+                                         memory.legs) - memory.retries
+                                         < self._config.max_regrasps),
+                                     return_home=memory.retries < self._config.max_retries))
 
     def _calc_dispenser(self, context, output):
         """1 while a pourIn plan holds the container under the dispenser (its first
@@ -610,13 +740,17 @@ class Supervisor(LeafSystem):
             return
         waiting = {Phase.gate: "waiting for the gate check",
                    Phase.planning: f"waiting for plan attempt {memory.attempt}",
-                   Phase.executing: f"executing the plan (checks passed: {memory.checks_passed})"}
+                   Phase.executing: f"executing the plan (checks passed: {memory.checks_passed})",
+                   Phase.looking: f"waiting for perception to look again (request "
+                                  f"{memory.looks + (memory.look_after is not None)}, after "
+                                  f"leg {len(memory.legs)})"}
         # A run stopped now (a timeout, an error) has not done its task.
         task = (TaskOutcome(self._task, False, {}, f"not done: {waiting[memory.phase]}")
                 if self._task else None)
         output.set_value(Outcome(Status.pending, Reason.none, waiting[memory.phase],
                                  unreachable_parts=memory.collisions,
-                                 requeries=memory.requeries, task_outcome=task))
+                                 requeries=memory.requeries, task_outcome=task,
+                                 legs=memory.legs))
 
 
 def _touches(contact_results, a: frozenset, b: frozenset) -> bool:
