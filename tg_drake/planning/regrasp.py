@@ -21,8 +21,9 @@ intermediate poses (at most `regrasp_max_legs`, of `regrasp_max_poses` examined)
 leg is planned in full: picked with the current candidates (each followed by its
 finger-swapped twin, the same grasp: the wrist's last joint cannot turn a half turn about the
 vertical otherwise), placed in exactly that orientation, then the arm moved back to its start
-configuration, out of the camera's view, so that perception can look again. A bottle lying at the far edge of the reach, to be stood up,
-is so put down nearer, lying as it was, and picked again.
+configuration, out of the camera's view, so that perception can look again. An object lying at
+the far edge of the reach, to be stood up, is so put down nearer, lying as it was, and picked
+again.
 """
 
 from __future__ import annotations
