@@ -35,7 +35,7 @@ import numpy as np
 from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
-from tg_drake.grasping.feasibility import FeasibilityConfig, approach_variants
+from tg_drake.grasping.expansion import ExpansionConfig, executed_poses
 from tg_drake.perception.config import PregraspConfig
 from tg_drake.perception.pregrasp import part_pregrasps
 from tg_drake.planning.planner import (
@@ -125,22 +125,22 @@ def moved_object(target: ObjectDescription, X_WO_new: np.ndarray,
         part_boxes=boxes, pregrasp_X_WG=X_WG, pregrasp_parts=np.asarray(parts, int))
 
 
-def _second_leg_grasps(moved: ObjectDescription, table_z: float, carried=None
-                       ) -> tuple[np.ndarray, np.ndarray]:
+def _second_leg_grasps(moved: ObjectDescription, table_z: float, carried=None, *,
+                       approach: float) -> tuple[np.ndarray, np.ndarray]:
     """The grasps the second leg's reach check tries: `carried` first ((X_WG, part labels): the
     current candidates moved with the object, when its resting pose keeps its label), then the
-    moved object's pre-grasp hypotheses, each with its approach variants as the feasibility stage
-    makes them (`tg_drake.grasping.feasibility.approach_variants`)."""
-    config = FeasibilityConfig()
+    poses that may be executed for the moved object's pre-grasp hypotheses, as the scoring stage
+    makes them (`tg_drake.grasping.expansion.executed_poses`, the planner's approach
+    `approach` [m])."""
     poses, labels = [], []
     if carried is not None:
         poses += list(carried[0])
         labels += list(carried[1])
-    for X, label in zip(np.asarray(moved.pregrasp_X_WG, float).reshape(-1, 4, 4),
-                        moved.pregrasp_parts, strict=True):
-        variants = approach_variants(X, config, table_z=table_z)
-        poses += variants
-        labels += [int(label)] * len(variants)
+    hypotheses = np.asarray(moved.pregrasp_X_WG, float).reshape(-1, 4, 4)
+    X_WG, source = executed_poses(hypotheses, table_z, approach_distance=approach,
+                                  config=ExpansionConfig())
+    poses += list(X_WG)
+    labels += [int(k) for k in np.asarray(moved.pregrasp_parts, int)[source]]
     return np.asarray(poses, float).reshape(-1, 4, 4), np.asarray(labels, int)
 
 
@@ -152,7 +152,8 @@ def second_leg_reachable(moved: ObjectDescription, parts, *, placing: TaskPlacin
     ("" when one does):
     the planner's refusals, the task's turns and place yaws, inverse kinematics of each key
     pose (the motions between them are planned when the second leg is)."""
-    X_WG_all, labels = _second_leg_grasps(moved, table_z, carried)
+    X_WG_all, labels = _second_leg_grasps(moved, table_z, carried,
+                                          approach=config.pregrasp_distance)
     order = [i for part in parts for i in np.flatnonzero(labels == PART_LABELS.index(part))]
     if not order:
         return "no pre-grasp hypothesis on " + ", ".join(parts)
