@@ -56,8 +56,8 @@ OUTPUTS: dict[str, dict[str, str]] = {
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="tg-drake", description="Task-dependent robot grasping in Drake.",
-        epilog="exit status: 0 done (see `tg-drake run --help`), 1 the run or task failed, 2 bad "
-        "input or usage", formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog="exit status: 0 done, 1 the run failed or its task was not done, 2 bad input or "
+        "usage", formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"tg-drake {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, module_name in COMMANDS.items():

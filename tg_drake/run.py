@@ -226,7 +226,17 @@ def main(args) -> int:
                 time.sleep(1.0)
         except KeyboardInterrupt:
             pass
-    return 0 if result["outcome"]["status"] != "failed" else 1
+    return exit_status(result)
+
+
+def exit_status(result: dict) -> int:
+    """The command's exit status for a run: 0 done — the outcome is not `failed` and, where the
+    task has a physical check (result.json's `task_outcome`), the check passed —, 1 otherwise.
+    (2, bad input or usage, is tg_drake.cli's.)"""
+    if result["outcome"]["status"] == "failed":
+        return 1
+    task = result.get("task_outcome")
+    return 0 if task is None or task.get("success") else 1
 
 
 def bench_pipeline_rtf():

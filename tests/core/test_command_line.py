@@ -88,3 +88,12 @@ def test_the_eval_progress_bar_names_the_suites():
     assert progress_label(["scenarios/suites/s_grasp.yaml", "x/tiny.yaml"]) == "s_grasp, tiny"
     assert progress_label(["a.yaml"], (2, 4)) == "a [2/4]"
     assert progress_label([f"suite_number_{k}.yaml" for k in range(5)]) == "5 suites"
+
+
+@pytest.mark.parametrize("status, task, code", [
+    ("placed", None, 0), ("lifted", {"success": True}, 0), ("placed", {"success": False}, 1),
+    ("failed", None, 1), ("failed", {"success": True}, 1)])
+def test_run_exits_0_only_when_the_run_and_its_task_are_done(status, task, code):
+    from tg_drake.run import exit_status
+    result = {"outcome": {"status": status}, "task_outcome": task}
+    assert exit_status(result) == code
