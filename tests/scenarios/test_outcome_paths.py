@@ -10,6 +10,7 @@ regression and pipeline tests).
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -78,3 +79,34 @@ def test_run_and_composed_diagram_agree(path, name, cached_run):
     result = cached_run(path, name)
     through_run = (result["outcome"]["status"], result["outcome"]["reason"])
     assert outcome_by_hand(path, name) == through_run, result["outcome"]
+
+
+ENDS = re.compile(r"^# Ends: (placed|lifted|grasped|failed)(?: \((\w+)\))?(, task done)?$",
+                  re.MULTILINE)
+
+
+def expected_end(path: Path) -> tuple[str, str | None, bool]:
+    """(status, reason or None, task done) from a scenario header's `# Ends:` line."""
+    m = ENDS.search(path.read_text())
+    assert m, f"{path.name}: its header has no '# Ends: <status> [(<reason>)][, task done]' line"
+    return m.group(1), m.group(2), bool(m.group(3))
+
+
+EXAMPLES = [c for c in scenario_cases() if "/" not in c.id and "#" not in c.id]
+
+
+def test_every_example_says_how_it_ends():
+    for case in EXAMPLES:
+        expected_end(case.values[0])
+
+
+@pytest.mark.parametrize("path, name", EXAMPLES)
+def test_each_example_ends_as_its_header_says(path, name, cached_run):
+    status, reason, task_done = expected_end(path)
+    result = cached_run(path, name)
+    outcome = result["outcome"]
+    assert outcome["status"] == status, outcome
+    if reason is not None:
+        assert outcome["reason"] == reason, outcome
+    if task_done:
+        assert result["task_outcome"]["success"], result["task_outcome"]

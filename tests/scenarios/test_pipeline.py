@@ -127,7 +127,7 @@ def test_multi_object_scene_places_the_target_and_leaves_the_others():
 
 @pytest.mark.slow
 def test_full_mug_for_pour_out_is_held_by_its_middle_and_stays_upright():
-    result = run("mug_full_pour_out")
+    result = run("tasks/mug_pour_out")
     check_result_keys(result)
     assert result["grasp"]["part"] == "middle"
     assert result["outcome"]["status"] == "placed", result["outcome"]
