@@ -10,6 +10,7 @@ from __future__ import annotations
 import importlib
 import json
 import statistics
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -70,14 +71,25 @@ def add_arguments(parser) -> None:
                         help="run only this figure (repeatable)")
 
 
+def rounded(value, digits: int = 4):
+    """Floats to `digits` significant digits, through dicts and lists (timings vary more)."""
+    if isinstance(value, float):
+        return float(f"{value:.{digits}g}")
+    if isinstance(value, dict):
+        return {k: rounded(v, digits) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [rounded(v, digits) for v in value]
+    return value
+
+
 def main(args) -> int:
     names = args.only or list(FIGURES)
     results = {}
     for name in names:
         module_name, function_name = FIGURES[name].split(":")
         fn = getattr(importlib.import_module(module_name), function_name)
-        results[name] = asdict(fn())
-        print(f"{name}: {results[name]}", flush=True)
+        results[name] = rounded(asdict(fn()))
+        print(f"{name}: {results[name]}", file=sys.stderr, flush=True)  # progress: stdout is JSON
     text = json.dumps(results, indent=2)
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)

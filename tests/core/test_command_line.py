@@ -97,3 +97,20 @@ def test_run_exits_0_only_when_the_run_and_its_task_are_done(status, task, code)
     from tg_drake.run import exit_status
     result = {"outcome": {"status": status}, "task_outcome": task}
     assert exit_status(result) == code
+
+
+def test_bench_writes_only_json_on_stdout_with_rounded_figures(capsys, monkeypatch):
+    import json
+
+    from tg_drake import bench
+    monkeypatch.setitem(bench.FIGURES, "fake", "tests.core.test_command_line:_fake_figure")
+    assert cli.main(["bench", "--only", "fake"]) == 0
+    out = capsys.readouterr()
+    data = json.loads(out.out)  # nothing but the JSON
+    assert data["fake"]["median"] == 1.085 and data["fake"]["speedup"] == 1060.0
+    assert "fake:" in out.err  # the progress line
+
+
+def _fake_figure():
+    from tg_drake.bench import figure
+    return figure(1.084709496353753, "ms", "a reference", 1149.459994994686)
