@@ -17,6 +17,15 @@ from tg_drake.types import (
 GRASP_POINT = float(WSG_GRASP_POINT_G[1])  # [m] the grasp point along +y_G from the WSG body origin
 
 
+def top_down(p_grasp):
+    """A top-down grasp with its grasp point at p_grasp: x_G = x_W (closing), y_G = −z_W
+    (approach down), z_G = y_W."""
+    X = np.eye(4)
+    X[:3, :3] = np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]], float)
+    X[:3, 3] = np.asarray(p_grasp, float) - X[:3, 1] * WSG_GRASP_POINT_G[1]
+    return X
+
+
 def grasp_pose(p_W_grasp, approach_W, closing_W) -> np.ndarray:
     """X_WG (4×4) with the grasp point at p_W_grasp, approach +y_G, fingers closing along x_G."""
     y = np.asarray(approach_W, float) / np.linalg.norm(approach_W)

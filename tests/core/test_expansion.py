@@ -4,6 +4,7 @@ alike."""
 
 import numpy as np
 import pytest
+from grasp_helpers import top_down
 
 from tg_drake.errors import ScenarioError
 from tg_drake.grasping.dataset import SamplingConfig, scene_grasps
@@ -21,15 +22,6 @@ from tg_drake.scenario import PipelineConfig
 from tg_drake.types import ObjectDescription, SceneDescription
 
 CONFIG = ExpansionConfig()
-
-
-def top_down(p_grasp):
-    """A top-down grasp with its grasp point at p_grasp: x_G = x_W (closing), y_G = −z_W
-    (approach down), z_G = y_W."""
-    X = np.eye(4)
-    X[:3, :3] = np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]], float)
-    X[:3, 3] = np.asarray(p_grasp, float) - X[:3, 1] * WSG_GRASP_POINT_G[1]
-    return X
 
 
 def grasp_point(X):

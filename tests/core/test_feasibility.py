@@ -3,6 +3,7 @@ the hold model (the executed poses: test_expansion.py)."""
 
 import numpy as np
 import pytest
+from grasp_helpers import top_down
 
 from tg_drake.grasping.feasibility import (
     FEATURES,
@@ -16,7 +17,7 @@ from tg_drake.grasping.feasibility import (
     load_hold_model,
     mean_density,
 )
-from tg_drake.robot import WSG_GRASP_POINT_G, WSG_MAX_OPENING, WSG_PAD_SIZE
+from tg_drake.robot import WSG_MAX_OPENING, WSG_PAD_SIZE
 
 CONFIG = FeasibilityConfig()
 
@@ -28,15 +29,6 @@ def box_surface(size, centre=(0.0, 0.0, 0.0), spacing=0.002):
     g = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     on = np.any(np.isclose(np.abs(g), size / 2, atol=spacing / 2), axis=1)
     return g[on] + centre
-
-
-def top_down(p_grasp):
-    """A top-down grasp with its grasp point at p_grasp: x_G = x_W (closing), y_G = −z_W
-    (approach down), z_G = y_W."""
-    X = np.eye(4)
-    X[:3, :3] = np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]], float)
-    X[:3, 3] = np.asarray(p_grasp, float) - X[:3, 1] * WSG_GRASP_POINT_G[1]
-    return X
 
 
 def test_signed_distance_of_points_to_a_box():
