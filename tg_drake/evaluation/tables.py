@@ -383,6 +383,15 @@ def _success_row(rs: list[dict]) -> dict:
             "n_e0": len(e0), "E0_executed": _pct(e0)}
 
 
+def _task_rows(task_success: dict):
+    """(task, variant, row) of the task-success table, the derived Pipeline − Local row left out
+    (the text and the markdown tables both list these)."""
+    for task_name, by_variant in task_success.items():
+        for v, r in by_variant.items():
+            if v != "pipeline_minus_local":
+                yield task_name, v, r
+
+
 def task_success(records) -> dict:
     """Task success in physics per task × variant (the task suites' runs): over all runs and over
     the runs with a reachable pre-grasp, on each side of the split, with the executed E0 (the
@@ -422,15 +431,12 @@ def task_success_text(t: dict) -> str:
         return ""
     lines = ["task success in physics [%] (all runs / runs with a reachable pre-grasp; "
              "train | held-out, all runs):"]
-    for task_name, by_variant in rows.items():
-        for v, r in by_variant.items():
-            if v == "pipeline_minus_local":
-                continue
-            sp = r["split"]
-            lines.append(f"  {task_name:16s} {LABELS[v]:17s} {r['n']:4d} runs  "
-                         f"{_f(r['success']):>6s} / {_f(r['success_reachable']):>6s}  "
-                         f"({_f(sp['train']['success'])} | {_f(sp['held_out']['success'])})  "
-                         f"E0 executed {_f(r['E0_executed'])}")
+    for task_name, v, r in _task_rows(rows):
+        sp = r["split"]
+        lines.append(f"  {task_name:16s} {LABELS[v]:17s} {r['n']:4d} runs  "
+                     f"{_f(r['success']):>6s} / {_f(r['success_reachable']):>6s}  "
+                     f"({_f(sp['train']['success'])} | {_f(sp['held_out']['success'])})  "
+                     f"E0 executed {_f(r['E0_executed'])}")
     return "\n".join(lines)
 
 
@@ -645,17 +651,14 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
               "| task | variant | runs | success | reachable | success of reachable | train "
               "| held-out | E0 executed (runs) | task checks failed, by detail |",
               "|---|---|---|---|---|---|---|---|---|---|"]
-        for task_name, by_variant in t["task_success"].items():
-            for v, r in by_variant.items():
-                if v == "pipeline_minus_local":
-                    continue
-                sp = r["split"]
-                L.append(f"| {task_name} | {LABELS[v]} | {r['n']} | **{_f(r['success'])}** | "
-                         f"{r['n_reachable']} | {_f(r['success_reachable'])} | "
-                         f"{_f(sp['train']['success'])} ({sp['train']['n']}) | "
-                         f"{_f(sp['held_out']['success'])} ({sp['held_out']['n']}) | "
-                         f"{_f(r['E0_executed'])} ({r['n_e0']}) | "
-                         + "; ".join(f"{k} {n}" for k, n in r["failures"].items()) + " |")
+        for task_name, v, r in _task_rows(t["task_success"]):
+            sp = r["split"]
+            L.append(f"| {task_name} | {LABELS[v]} | {r['n']} | **{_f(r['success'])}** | "
+                     f"{r['n_reachable']} | {_f(r['success_reachable'])} | "
+                     f"{_f(sp['train']['success'])} ({sp['train']['n']}) | "
+                     f"{_f(sp['held_out']['success'])} ({sp['held_out']['n']}) | "
+                     f"{_f(r['E0_executed'])} ({r['n_e0']}) | "
+                     + "; ".join(f"{k} {n}" for k, n in r["failures"].items()) + " |")
         diffs = {k: v.get("pipeline_minus_local") for k, v in t["task_success"].items()
                  if v.get("pipeline_minus_local") is not None}
         if diffs:
