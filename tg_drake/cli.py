@@ -48,7 +48,7 @@ OUTPUTS: dict[str, dict[str, str]] = {
     "bench": {"out": "file"},
     "render": {"out": "folder"},
     "run": {"out": "folder"},
-    "eval": {"out": "folder", "tables": "folder"},
+    "eval": {"out": "folder", "tables": "folder", "export": "folder"},
     "import-object": {"out": "folder"},
 }
 

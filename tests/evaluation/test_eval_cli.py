@@ -175,3 +175,40 @@ def test_the_bar_counts_an_executed_case_by_its_outcome_and_others_as_done():
     assert outcome_label([{"outcome": {"status": "placed", "reason": ""}}]) == "placed"
     assert outcome_label([{"outcome": {"status": "failed", "reason": "missed"}}]) == "failed"
     assert outcome_label([{"methods": {}}, {"methods": {}}]) == "done"  # perceived: 2 settings
+
+
+def test_cases_selects_by_pattern_and_list_prints_the_keys_without_an_output_folder(capsys):
+    assert eval_(SUITES / "s_grasp.yaml", "--cases", "s_grasp/pan_03_upright*", "--cases",
+                 "s_grasp/knife_0?_sideways_empty_pass@pipeline", "--list") == 0
+    keys = capsys.readouterr().out.split()
+    assert sorted(keys) == sorted(
+        [f"s_grasp/pan_03_upright_empty_{t}@pipeline" for t in ("pass", "p&pOn", "p&pInUpright")]
+        + [k for k in keys if k.startswith("s_grasp/knife_")])
+    assert any(k.startswith("s_grasp/knife_") for k in keys)
+    assert eval_(SUITES / "s_grasp.yaml", "--cases", "no_such_case*", "--list") == 2
+    err = capsys.readouterr().err
+    assert "field '--cases': no case's key matches 'no_such_case*' (of 132 cases" in err
+    assert eval_(SUITES / "s_grasp.yaml") == 2  # neither --out nor --list/--export
+    assert "field '--out': the output folder is missing" in capsys.readouterr().err
+
+
+def test_an_exported_case_is_the_scenario_the_sweep_runs(tmp_path, capsys):
+    from pydrake.common.yaml import yaml_dump_typed
+
+    from tg_drake.evaluation.jobs import scenario_of
+    from tg_drake.evaluation.suite import load_suite
+    from tg_drake.scenario import LocalOnly, load_scenario
+
+    suite = SUITES / "s_grasp_baselines.yaml"
+    key = "s_grasp_baselines/cup_01_upright_empty_pass@local"
+    assert eval_(suite, "--cases", key, "--export", tmp_path) == 0
+    files = list(tmp_path.iterdir())
+    assert [f.name for f in files] == ["s_grasp_baselines_cup_01_upright_empty_pass_local.yaml"]
+    assert f"tg-drake run {files[0]}" in files[0].read_text().splitlines()[1]
+    loaded = load_scenario(files[0])
+    assert isinstance(loaded.pipeline.scoring, LocalOnly)
+    case = next(c for c in load_suite(suite)[1] if c.key == key)
+    assert yaml_dump_typed(loaded) == yaml_dump_typed(scenario_of(case))
+    # A selection without an executed case has no scenario to write.
+    assert eval_(TINY, "--cases", "tiny/*", "--export", tmp_path / "none") == 2
+    assert "only executed cases are scenarios" in capsys.readouterr().err

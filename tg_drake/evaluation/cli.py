@@ -10,6 +10,11 @@ given (`--name logic`: logic.json, logic.md, logic_*.png), and prints the task s
 and variant when the task suites are among them. `--tables-only` derives the tables from the
 records already there.
 
+`--cases PATTERN` keeps the cases whose key matches a shell-style pattern (repeatable), e.g.
+`--cases 's_grasp/pan_03_*@pipeline'`; `--list` prints the keys and stops; `--export DIR` writes
+each executed case as a scenario file that `tg-drake run` runs as the sweep would (the case's
+scene, task scene and variant's pipeline), to reproduce and inspect one case.
+
 `--shard I/N` runs the I-th of N deterministic slices of the cases into `results-I-of-N.jsonl`
 (tg_drake.evaluation.shards); the tables are always derived from every results file in DIR (and
 any given with `--merge`), duplicates and missing cases reported.
@@ -18,6 +23,7 @@ any given with `--merge`), duplicates and missing cases reported.
 from __future__ import annotations
 
 import dataclasses
+import fnmatch
 import json
 import re
 import shlex
@@ -47,7 +53,8 @@ HELP = "run evaluation suites (progress bar, resumable results.jsonl) and write 
 def add_arguments(parser) -> None:
     parser.add_argument("suites", type=Path, nargs="+", metavar="SUITE",
                         help="suite YAML files (scenarios/suites/)")
-    parser.add_argument("--out", type=Path, required=True, help="output folder")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="output folder (needed unless --list or --export)")
     parser.add_argument("--executor", choices=EXECUTORS, default="local",
                         help="local process pool (default) or a Ray cluster")
     parser.add_argument("--workers", type=int, default=None,
@@ -71,6 +78,14 @@ def add_arguments(parser) -> None:
     parser.add_argument("--shard", default=None, metavar="I/N",
                         help="run only the I-th of N deterministic slices of the cases (1 ≤ I ≤ "
                              "N), into DIR/results-I-of-N.jsonl; merge with --tables-only")
+    parser.add_argument("--cases", action="append", default=[], metavar="PATTERN",
+                        help="only the cases whose key matches this shell-style pattern "
+                             "(repeatable; e.g. 's_grasp/pan_03_*@pipeline')")
+    parser.add_argument("--list", action="store_true",
+                        help="print the (selected) cases' keys and stop")
+    parser.add_argument("--export", type=Path, default=None, metavar="DIR",
+                        help="write each (selected) executed case as a scenario file for "
+                             "`tg-drake run`, and stop")
     parser.add_argument("--merge", type=Path, action="append", default=[], metavar="PATH",
                         help="with the tables: also read this results file, or the results "
                              "files of this folder (repeatable)")
@@ -170,6 +185,9 @@ def main(args) -> int:
     if not re.fullmatch(r"[\w.-]+", args.name):
         raise ScenarioError(f"--name is a file stem (letters, digits, '_', '-', '.'), got "
                             f"{args.name!r}", field="--name")
+    if args.out is None and not (args.list or args.export is not None):
+        raise ScenarioError("the output folder is missing: give --out DIR (only --list and "
+                            "--export need none)", field="--out")
     sharded = None
     if args.shard is not None:
         if args.tables_only:
@@ -184,6 +202,18 @@ def main(args) -> int:
                                field="--theory")
         cases = [dataclasses.replace(c, key=f"{c.key}#{args.theory}", theory=args.theory)
                  for c in cases]
+    if args.cases:
+        cases = select_cases(cases, args.cases)
+    if args.list:
+        for c in cases:
+            print(c.key)
+        return 0
+    if args.export is not None:
+        written = export_cases(cases, args.export)
+        print(f"{len(written)} scenario files in {args.export} (run one: tg-drake run "
+              f"{written[0] if written else args.export / '<case>.yaml'} --out out/case)",
+              file=sys.stderr)
+        return 0
     out = shard_file(args.out, *sharded) if sharded else args.out / "results.jsonl"
     if not args.tables_only:
         todo = shard(cases, *sharded) if sharded else cases
@@ -228,6 +258,46 @@ def main(args) -> int:
     print(f"{len(done)} of {len(cases)} cases have records; tables in {folder}/{args.name}.md "
           f"({tables['n_errors']} crashed cases counted as failures)")
     return 0
+
+
+def select_cases(cases, patterns) -> list:
+    """The cases whose key matches one of the shell-style patterns; ScenarioError naming --cases
+    and some of the keys when none does."""
+    chosen = [c for c in cases if any(fnmatch.fnmatchcase(c.key, p) for p in patterns)]
+    if not chosen:
+        some = ", ".join(c.key for c in cases[:3])
+        raise ScenarioError(f"no case's key matches {', '.join(map(repr, patterns))} (of "
+                            f"{len(cases)} cases, e.g. {some}; --list prints them all)",
+                            field="--cases")
+    return chosen
+
+
+def export_file_name(key: str) -> str:
+    """A case key as a file name: '/', '@', '#' and other non-word characters become '_'."""
+    return re.sub(r"[^\w.-]+", "_", key).strip("_") + ".yaml"
+
+
+def export_cases(cases, folder: Path) -> list[Path]:
+    """Writes every executed case's scenario (as the sweep runs it: tg_drake.evaluation.jobs.
+    scenario_of) to `folder` as YAML for `tg-drake run`; ScenarioError when no case is executed."""
+    from pydrake.common.yaml import yaml_dump_typed  # start-up (pydrake)
+
+    from tg_drake.evaluation.jobs import scenario_of  # start-up (pydrake)
+
+    executed = [c for c in cases if c.kind == "executed"]
+    if not executed:
+        raise ScenarioError("only executed cases are scenarios; the selection has none "
+                            f"(kinds: {sorted({c.kind for c in cases})})", field="--export")
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    for case in executed:
+        path = folder / export_file_name(case.key)
+        header = (f"# Case {case.key} of the suite {case.suite} ({case.kind}, variant "
+                  f"{case.variant}), written by tg-drake eval --export.\n"
+                  f"# Runs as the sweep runs it: tg-drake run {path} --out out/case\n")
+        path.write_text(header + yaml_dump_typed(scenario_of(case)))
+        written.append(path)
+    return written
 
 
 def outcome_label(records: list[dict]) -> str:
