@@ -641,3 +641,41 @@ def test_a_straight_move_onto_another_ik_branch_has_its_start_solved_again(monke
                                      "place", "retreat"]
     assert np.max(np.abs(poses["grasp"] - poses["pre-grasp"])) < planner.BRANCH_JUMP
     np.testing.assert_allclose(poses["pre-grasp"], flipped + 0.01)
+
+
+def test_the_placed_object_is_its_part_shapes_moved_not_its_whole_box():
+    """Backing out of a placed object is judged as going into it was: a side grasp on the narrow
+    upper part of a wide-based object puts the gripper inside the object's box but clear of its
+    parts; at the place the same grasp must be as clear (the whole box there made the retreat of
+    rim and upper-part grasps fail)."""
+    from tg_drake.planning.planner import _Arms, placed_shapes, target_shapes
+
+    X_WO = np.eye(4)
+    X_WO[:3, 3] = [0.70, 0.15, 0.07]
+    obj = box_object(X_WO[:3, 3], [0.20, 0.20, 0.14])
+    base = np.eye(4)
+    base[:3, 3] = [0.70, 0.15, 0.01]
+    upper = np.eye(4)
+    upper[:3, 3] = [0.70, 0.15, 0.08]
+    obj.part_boxes = {"bottom": PartBox(base, np.array([0.10, 0.10, 0.01])),
+                      "top": PartBox(upper, np.array([0.015, 0.015, 0.06]))}
+    obj.part_probabilities = {"bottom": 1.0, "top": 1.0}
+    X_WO_place = np.eye(4)
+    X_WO_place[:3, 3] = [0.60, -0.30, 0.07]
+    moved = placed_shapes(target_shapes(obj), RigidTransform(X_WO).inverse(), X_WO_place)
+    assert [name for name, _, _ in moved] == ["target_placed_bottom", "target_placed_top"]
+    np.testing.assert_allclose(moved[1][1].translation(), [0.60, -0.30, 0.08], atol=1e-12)
+
+    arms = _Arms(None, PlannerConfig().open_width, [], target_shapes(obj),
+                 ("target_placed", RigidTransform(X_WO_place), tuple(obj.extents)), X_WO=X_WO)
+    X_WG = grasp_pose([0.70, 0.15, 0.10], approach_W=[1, 0, 0], closing_W=[0, 1, 0])
+    X_WG_place = X_WO_place @ np.linalg.inv(X_WO) @ X_WG
+    for arm, X in ((arms.grasp, X_WG), (arms.placed(X_WO_place), X_WG_place)):
+        r = solve_ik_seeds(arm, RigidTransform(X), [np.array(IIWA_HOME)], min_distance=0.003)
+        assert r.success, r.reason
+        assert clearance(arm, r.q) >= 0.003 - 1e-4
+    # The whole box at the place would put the gripper inside it: no such configuration.
+    whole = make_arm_plant(obstacles=[("box", RigidTransform(X_WO_place), tuple(obj.extents))],
+                           finger_contact=["box"])
+    assert not solve_ik_seeds(whole, RigidTransform(X_WG_place), [np.array(IIWA_HOME)],
+                              min_distance=0.003).success

@@ -305,7 +305,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
               for s in surfaces]
     target_box = target_shapes(target)
     placed_box = ("target_placed", RigidTransform(X_WO_place), tuple(target.extents))
-    arms = _Arms(scenario, config.open_width, boxes, target_box, placed_box)
+    arms = _Arms(scenario, config.open_width, boxes, target_box, placed_box, X_WO=X_WO)
     bearing = float(np.arctan2(X_WO[1, 3], X_WO[0, 3]))
     seeds = _seeds(q_start, config.seed_postures, bearing)
 
@@ -540,12 +540,17 @@ class _Arms:
     free: the other objects and the target are obstacles (moving to the pre-grasp);
     grasp: the same, but the finger pads may overlap the target's box (approach, grasp, lift);
     carry(X_GO): the other objects, and the target's box in the hand (lift to place);
-    placed: the other objects and the target at its place pose, which the finger pads may overlap
-    (release, retreat)."""
+    placed: the other objects and the target's shapes moved with it to its place pose, which the
+    finger pads may overlap (release, retreat): the same shapes as at the grasp, so that backing
+    out of a placed object is judged as going into it was (the object's whole box there would put
+    fingers that straddle a wall or a rim inside it).
 
-    def __init__(self, scenario, opening, boxes, target_shapes, placed_box):
+    `X_WO`: the target's pose now, where `target_shapes` stand."""
+
+    def __init__(self, scenario, opening, boxes, target_shapes, placed_box, *, X_WO):
         self._scenario, self._opening = scenario, opening
         self._boxes, self._target, self._placed = list(boxes), list(target_shapes), placed_box
+        self._X_OW = RigidTransform(np.asarray(X_WO, float)).inverse()
         self._cache: dict = {}
         self._held_size = tuple(placed_box[2])  # the object's box, carried in the hand
 
@@ -565,14 +570,22 @@ class _Arms:
         return self._make("grasp", self._target, finger_contact=[t[0] for t in self._target])
 
     def placed(self, X_WO_place: np.ndarray) -> ArmPlant:
-        name, _, size = self._placed
         key = ("placed", tuple(np.round(np.asarray(X_WO_place).ravel(), 9)))
-        box = (name, RigidTransform(np.asarray(X_WO_place)), size)
-        return self._make(key, [box], finger_contact=[name])
+        shapes = placed_shapes(self._target, self._X_OW, X_WO_place)
+        return self._make(key, shapes, finger_contact=[t[0] for t in shapes])
 
     def carry(self, X_GO: RigidTransform) -> ArmPlant:
         key = ("carry", tuple(np.round(X_GO.GetAsMatrix4().ravel(), 9)))
         return self._make(key, held=(X_GO, self._held_size))
+
+
+def placed_shapes(shapes, X_OW: RigidTransform, X_WO_place) -> list[tuple]:
+    """The target's obstacle shapes (`target_shapes`, in the world where the object is now, X_OW
+    the inverse of its pose) moved rigidly with the object to `X_WO_place`, renamed
+    target_placed_*."""
+    X_move = RigidTransform(np.asarray(X_WO_place, float)) @ X_OW
+    return [(name.replace("target", "target_placed", 1), X_move @ X, size)
+            for name, X, size in shapes]
 
 
 def _seeds(q_start, postures, bearing) -> list[np.ndarray]:
