@@ -92,3 +92,25 @@ def test_outcomes_over_all_runs(tables):
     assert (o["n"], o["grasped"], o["lifted"], o["placed"]) == (2, 50.0, 50.0, 50.0)
     assert o["failures"] == {"missed": 1}
     assert sum(row["n"] for row in o["per_category"].values()) == 2
+
+
+def test_a_pass_handed_over_counts_as_placed_and_one_not_taken_says_so():
+    """A pass ends lifted (the robot lets go in the air): placed when the receiver holds it, else
+    a failure "not handed over" (not an "error")."""
+    from tg_drake.evaluation.tables import grasp_and_place, outcomes
+
+    executed = [r for r in RECORDS if r["kind"] == "executed" and r["variant"] == "pipeline"][0]
+
+    def run(job, status, success):
+        task = {"task": "pass", "success": success, "measure": {}, "detail": ""}
+        return {**executed, "job": job, "task_given": "pass",
+                "outcome": {**executed["outcome"], "status": status, "reason": "",
+                            "task_outcome": task}}
+
+    records = [run("small/a", "lifted", True), run("small/b", "lifted", False),
+               run("small/c", "placed", None)]
+    o = outcomes(records)["grasp"]["pipeline"]
+    assert (o["n"], o["lifted"], o["placed"]) == (3, 100.0, round(100 * 2 / 3, 2))
+    assert o["failures"] == {"not handed over": 1}
+    g = grasp_and_place(records)
+    assert sum(row["placed"] for row in g.values()) == 2
