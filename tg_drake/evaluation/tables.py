@@ -694,8 +694,8 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
         L += ["", "## Outcomes of the executed runs (ours)", "",
               "Over all runs (the paper's table above counts grasped and placed over the runs "
               "with a reachable pre-grasp): grasped = the object was in the hand, lifted = held "
-              "through the lift, placed = put down as the task asks, or handed over to the receiver "
-              "for a pass.", "",
+              "through the lift, placed = put down as the task asks, or handed over to the "
+              "receiver for a pass.", "",
               "| dataset | variant | runs | grasped | lifted | placed | not placed, by reason | "
               "median wall time [s] |", "|---|---|---|---|---|---|---|---|"]
         for d, by_variant in t["outcomes"].items():
