@@ -108,7 +108,7 @@ def _handed_over(r) -> bool:
     return _status(r) == "lifted" and task.get("task") == "pass" and bool(task.get("success"))
 
 
-def _delivered(r) -> bool:
+def delivered(r) -> bool:
     """The paper's "placed": the object put down where the task wants it, or for a pass handed
     over to the receiver (the pass's place is the receiver's hand)."""
     return _status(r) == "placed" or _handed_over(r)
@@ -349,7 +349,7 @@ def grasp_and_place(records) -> dict:
                   "reachable": len(reachable), "reachable_pct": _pct([bool(r.get("grasp"))
                                                                      for r in rs]),
                   "grasped": sum(_status(r) in ("grasped", *HELD) for r in reachable),
-                  "placed": sum(_delivered(r) for r in reachable),
+                  "placed": sum(delivered(r) for r in reachable),
                   "failures": _failures(rs)}
         for k in ("grasped", "placed"):
             out[n][f"{k}_pct"] = (round(100.0 * out[n][k] / len(reachable), 2)
@@ -377,7 +377,7 @@ def outcomes(records) -> dict:
             out.setdefault(dataset, {})[variant] = {
                 "n": len(ex),
                 **{k: _pct([_status(r) in v for r in ex]) for k, v in reached.items()},
-                "placed": _pct([_delivered(r) for r in ex]),
+                "placed": _pct([delivered(r) for r in ex]),
                 "failures": _failures(ex),
                 "per_category": {c: dict(per_category[c]) for c in CATEGORIES if c in per_category},
                 "wall_seconds_median": round(float(np.median(wall)), 2) if wall else None}
@@ -468,7 +468,7 @@ def task_success_text(t: dict) -> str:
 def _failures(rs) -> dict:
     counts: dict = defaultdict(int)
     for r in rs:
-        if not _delivered(r):
+        if not delivered(r):
             counts[_not_delivered_reason(r)] += 1
     return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
 
