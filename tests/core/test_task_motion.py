@@ -113,3 +113,28 @@ def test_a_pour_puts_the_opening_over_the_bowl_and_tilts_it_there():
     lying[:3, :3] = LYING
     assert pour_poses(lying, extents, X_WG, bowl_xy=bowl_xy, bowl_top=bowl_top,
                       tilt=1.9, clearance=0.05) == []
+
+
+@pytest.mark.parametrize("task, where", [("pourOut", dict(pour_at=(0.7, -0.25))),
+                                         ("pourIn", dict(fill_at=(0.65, -0.25, 0.3)))])
+def test_a_pour_places_at_the_target_else_back_where_it_was_picked(task, where):
+    # A pour is judged at the bowl or the dispenser: the container's place target (here 0.9 m
+    # out, past where a side grasp reaches) comes first, then its own pick spot.
+    X_WO = np.eye(4)
+    X_WO[:3, 3] = [0.75, 0.05, 0.061]
+    extents = [0.08, 0.08, 0.1]
+    placing = task_placing(task, place_xy=(0.9, -0.3), table_z=0.0, **where)
+    assert placing.pours
+    (R0, X0), (R1, X1) = placing.place_poses(X_WO, R_SIDE, extents, is_tool=False,
+                                             release_height=0.01, place_pose=place_pose)
+    assert R0 is None and R1 is None
+    assert np.allclose(X0[:3, 3], [0.9, -0.3, 0.06])
+    assert np.allclose(X1[:3, 3], [0.75, 0.05, 0.06])  # the pick spot, 1 cm over the table
+    assert np.allclose(X1[:3, :3], X_WO[:3, :3])
+    # Already at the target, or not a pour: the one place target only.
+    assert len(placing.place_poses(X0, R_SIDE, extents, is_tool=False, release_height=0.01,
+                                   place_pose=place_pose)) == 1
+    plain = task_placing("pass", place_xy=(0.9, -0.3), table_z=0.0)
+    assert not plain.pours
+    assert len(plain.place_poses(X_WO, R_SIDE, extents, is_tool=False, release_height=0.01,
+                                 place_pose=place_pose)) == 1

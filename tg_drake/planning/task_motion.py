@@ -21,6 +21,8 @@
 - pourIn: carried upright under the dispenser (`fill_at`), its box `fill_clearance` under the
   hopper's gate; held there `fill_open` with the dispenser open (the supervisor's
   ``dispenser_command``) and `fill_settle` more, then placed as usual.
+- pourOut and pourIn are judged at the pour: when the place target is out of reach for a grasp,
+  the container goes back where it was picked (reachable by that grasp: it was picked there).
 - every other task: the pick-and-place, the object's orientation kept.
 
 Each place pose is also turned about the vertical by `PlannerConfig.place_yaws`.
@@ -234,6 +236,11 @@ class TaskPlacing:
     regrasp_max_legs: int = 3  # (TaskMotionConfig)
 
     @property
+    def pours(self) -> bool:
+        """Does the task pour out (over a bowl) or fill (under a dispenser)?"""
+        return self.pour_at is not None or self.fill_at is not None
+
+    @property
     def hold(self) -> float:
         """[s] how long the container is held at the pour (tilted) or under the dispenser."""
         return self.fill_open + self.fill_settle if self.fill_at is not None else self.pour_hold
@@ -253,8 +260,16 @@ class TaskPlacing:
                                    table_z=self.support_z, release_height=height))
                     for height in self.turned_release_heights]
         if self.pose is None:
-            return [(None, place_pose(X_WO, extents, self.place_xy, table_z=self.support_z,
-                                      release_height=release_height))]
+            out = [(None, place_pose(X_WO, extents, self.place_xy, table_z=self.support_z,
+                                     release_height=release_height))]
+            if self.pours and not np.allclose(X_WO[:2, 3], self.place_xy, atol=1e-6):
+                # A pour is judged at the bowl or the dispenser, not where the container ends:
+                # when the place target is out of this grasp's reach it goes back where it was
+                # picked, which the same grasp reached (the pick's own pose, raised
+                # `release_height`).
+                out.append((None, place_pose(X_WO, extents, X_WO[:2, 3], table_z=self.support_z,
+                                             release_height=release_height)))
+            return out
         out = []
         for R in turns_to_pose(X_WO[:3, :3], np.asarray(X_WG, float)[:3, :3], self.pose,
                                is_tool=is_tool):
