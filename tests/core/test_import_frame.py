@@ -87,7 +87,18 @@ def test_container_frame_is_the_shipped_one(obj_id):
 def test_tool_frame_is_the_shipped_one(obj_id, pose):
     fr, T = _derived(obj_id, pose, True)
     o = LIB[obj_id]
-    assert T[0, 0] > math.cos(math.radians(5.0)), \
+    # x lies in the plane the tool rests on. A flat tool lies along its length: x within 5° of
+    # the shipped one. A round tool (a screwdriver) rests on its handle and its tip, so its shaft
+    # tilts out of that plane, in any direction about the shaft since it may roll: by at most
+    # the handle's radius over the half length (the handle's contact lies within its half,
+    # the tip at the end), e.g. 10° for screwdriver_04 (measured: 5.2°).
+    limit = 5.0
+    if o.category == "screwdriver":
+        V, _, _ = mesh(obj_id)
+        yz = V[:, 1:]
+        r_max = float(np.linalg.norm(yz - 0.5 * (yz.max(0) + yz.min(0)), axis=1).max())
+        limit = math.degrees(math.atan(r_max / (0.5 * np.ptp(V[:, 0]))))
+    assert T[0, 0] > math.cos(math.radians(limit)), \
         "x does not point from the handle to the usable area"
     if o.category != "screwdriver":  # a round tool rests on any side: any roll about x is right
         # Flat tools lie on either face (a half turn about x): z up to sign. 5°: the library
