@@ -99,8 +99,9 @@ class ObjectDescription:
     name: str = ""  # ground-truth instance name when known (GroundTruthPerception), else "".
     interior_seen: float = 0.0  # probability that its inside was seen through a wide opening.
     pose_cue: str = ""  # what decided the pose (perception.pose.PoseEstimate.cue), or "".
-    pose_end: tuple | None = None  # the closed end on top, (recess, dome) [m], when the pose
-    # reached that cue (perception.pose.closed_end), else None.
+    pose_end: tuple | None = None  # the closed end on top, (recess, dome, rise, rise error)
+    # [m] and its wall's (narrowing, error) [m/m] (NaN: no wall), when the pose reached that cue
+    # (perception.pose.closed_end, wall_taper), else None.
 
 
 @dataclass

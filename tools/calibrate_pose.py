@@ -15,10 +15,11 @@ view). Two fits on these views:
 
     .venv/bin/python tools/calibrate_pose.py  # → tg_drake/data/pose_likelihood.json
     .venv/bin/python tools/calibrate_pose.py --sensor ideal --out /tmp/pose.json
-    .venv/bin/python tools/calibrate_pose.py --sensor d415 --closed-end --out /tmp/pose.json
+    .venv/bin/python tools/calibrate_pose.py --sensor d415 --no-closed-end --out /tmp/pose.json
 
-Step 1 only with `--closed-end` (the shipped file holds no closed-end model: fitted on training
-views, it reads a flat closed top as a base, so flat-topped solids read upside-down).
+`--no-closed-end` skips step 1 (the closed-end cue off). With it, the closed-end decisions of
+step 2 are `pose.closed_end_decision`'s: what the model reads as a base is a base only with
+evidence other than the missing lid (an end pushed in, or a wall narrowing from the table up).
 """
 
 from __future__ import annotations
@@ -39,6 +40,8 @@ from tg_drake.perception.pose import (
     ClosedEnd,
     ClosedEndModel,
     PoseCalibration,
+    WallTaper,
+    closed_end_decision,
 )
 from tg_drake.perception.render import perceive
 from tg_drake.perception.sensor_model import IdealDepth, StructuredLight
@@ -62,7 +65,7 @@ def fit_closed_end(views: list[tuple]) -> tuple[ClosedEndModel | None, int]:
     cue, upright or upside-down; None with fewer than two classes. Returns (model, views used)."""
     from sklearn.linear_model import LogisticRegression
 
-    used = [(pose, ClosedEnd(*d.pose_end)) for pose, d in views
+    used = [(pose, ClosedEnd(*d.pose_end[:4])) for pose, d in views
             if d.pose_end is not None and pose in ("upright", "upsidedown")]
     y = np.array([pose == "upsidedown" for pose, _ in used])
     if len(set(y.tolist())) < 2:
@@ -78,17 +81,19 @@ def decide(d, model: ClosedEndModel | None) -> tuple[str, str]:
     perceived with another: only the closed-end cue's decisions change)."""
     if d.pose_end is None or model is None:
         return d.pose, d.pose_cue
-    upside_down = model.p_upsidedown(ClosedEnd(*d.pose_end)) > 0.5
-    return ("upsidedown", "base") if upside_down else ("upright", "lid")
+    narrowing, error = d.pose_end[4:]
+    wall = None if np.isnan(narrowing) else WallTaper(narrowing, error)
+    top_sign, cue = closed_end_decision(model, ClosedEnd(*d.pose_end[:4]), wall)
+    return ("upright" if top_sign > 0 else "upsidedown"), cue
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sensor", choices=("default", "ideal", "d415"), default="default")
     parser.add_argument("--out", type=Path, default=CALIBRATION_FILE)
-    parser.add_argument("--closed-end", action="store_true",
-                        help="fit the closed-end model too (the cue is on where the file holds "
-                             "one; off by default: it reads flat-topped solids upside-down)")
+    parser.add_argument("--no-closed-end", dest="closed_end", action="store_false",
+                        help="do not fit the closed-end model (the file then holds none: the "
+                             "closed-end cue is off)")
     args = parser.parse_args(argv)
     sensor = {"default": DepthPerception().sensor, "ideal": IdealDepth(),
               "d415": StructuredLight()}[args.sensor]
@@ -132,7 +137,7 @@ def main(argv=None) -> int:
         print(f"{key:22s} {dict(out['counts'][key])}  →  " + ", ".join(
             f"{k} {v:.2f}" for k, v in p.items()))
     if model is not None:
-        ends = [(pose, ClosedEnd(*d.pose_end)) for pose, d in views if d.pose_end is not None
+        ends = [(pose, ClosedEnd(*d.pose_end[:4])) for pose, d in views if d.pose_end is not None
                 and pose in ("upright", "upsidedown")]
         right = sum((model.p_upsidedown(e) > 0.5) == (pose == "upsidedown") for pose, e in ends)
         print(f"closed-end model on {n_end} views: training accuracy {right / len(ends):.3f}")

@@ -79,3 +79,56 @@ def test_the_closed_end_measures_a_recessed_lid_a_flat_and_a_domed_base():
     assert lid.recess == pytest.approx(0.004, abs=2e-4) and abs(lid.dome) < 2e-4
     assert abs(flat.recess) < 2e-4 and abs(flat.dome) < 2e-4
     assert domed.recess > 0.004 and domed.dome > 0.0015  # [m] the dome rises off its centre
+
+
+def _frustum(r_table, r_top, H=0.12, top_height=None):
+    """Visible points and normals of a closed frustum on the table (radius r_table at the table,
+    r_top at its flat or shaped top, `top_height(r)` [m]), its half towards +x."""
+    from types import SimpleNamespace
+
+    top_height = top_height or (lambda r: H)
+    th = np.linspace(-np.pi / 2, np.pi / 2, 60)
+    slope = (r_table - r_top) / H  # [m/m] narrowing upwards
+    zs = np.arange(0.004, H - 0.001, 0.003)
+    wall = np.array([((r_table - slope * z) * np.cos(t), (r_table - slope * z) * np.sin(t), z)
+                     for t in th for z in zs])
+    n_wall = np.array([(np.cos(t), np.sin(t), slope) for t in th for z in zs])
+    step = 0.0015
+    g = np.arange(-r_top, r_top + step, step)
+    x, y = np.meshgrid(g, g)
+    r = np.hypot(x, y)
+    top = np.c_[x[r <= r_top], y[r <= r_top], [top_height(v) for v in r[r <= r_top]]]
+    p = np.vstack([wall, top])
+    n = np.vstack([n_wall / np.linalg.norm(n_wall, axis=1, keepdims=True),
+                   np.tile([0.0, 0.0, 1.0], (len(top), 1))])
+    m = len(p)
+    c = SimpleNamespace(p_T=p, visible=np.ones(m, bool), handle=np.zeros(m, bool),
+                        p_TA=np.array([0.0, 0.0, H / 2]))
+    return c, n
+
+
+def test_the_wall_taper_measures_the_draft_and_a_straight_wall_has_none():
+    from tg_drake.perception.pose import wall_taper
+
+    straight = wall_taper(*_frustum(0.03, 0.03))
+    drafted = wall_taper(*_frustum(0.04, 0.034))  # 6 mm over 120 mm: 0.05 m/m, about 2.9°
+    assert abs(straight.narrowing) < 1e-3 and not straight.significant
+    assert drafted.narrowing == pytest.approx(0.05, abs=0.003) and drafted.significant
+
+
+def test_a_flat_closed_top_is_upright_unless_the_wall_narrows_or_the_end_is_pushed_in():
+    """What the closed-end model reads as a base needs evidence beyond the missing lid: a flat
+    top on a straight wall (a solid cylinder) stays upright, on a wall narrowing from the table
+    (a tumbler on its rim) it is upside-down, and a base pushed in (a can's bottom) is one."""
+    from tg_drake.perception.pose import closed_end, closed_end_decision, wall_taper
+
+    model = load_pose_calibration().closed_end  # fitted on perceived training views
+    assert model is not None
+    H = 0.12
+    cases = {"flat": _frustum(0.03, 0.03), "rim": _frustum(0.04, 0.034),
+             "base": _frustum(0.03, 0.03, top_height=lambda r: H - 0.008 * max(0.0, 1 - r / 0.02)),
+             "lid": _frustum(0.03, 0.03, top_height=lambda r: H if r > 0.0225 else H - 0.004)}
+    signs = {"flat": 1.0, "rim": -1.0, "base": -1.0, "lid": 1.0}
+    for name, (c, n) in cases.items():
+        end = closed_end(c, n)
+        assert closed_end_decision(model, end, wall_taper(c, n)) == (signs[name], name), name

@@ -22,8 +22,22 @@ class SegmentationConfig:
     # through a triangulating camera at 1 m (the D415 model, sensor_model: σ = 1.8 mm on the
     # table at the default viewpoint, voxel averaging does not lower it, 0.1 % of the table's
     # voxels lie 5.7 mm above it). Flat parts thinner than this (blades lying flat, 2–3 mm) are
-    # not told from the table by height alone.
+    # not told from the table by a point's height alone: `thin_cell` patches are.
     min_object_height: float = 0.004
+    # Thin objects (segmentation.raised_cells): the points below min_object_height are gridded in
+    # cells of this side on the table [m] (about 20 pixels each at 1 m: the median's noise is a
+    # quarter of a pixel's); a cell whose median height exceeds `thin_significance` standard
+    # errors of that median (from the table's own noise at the cell's range), and at least
+    # `thin_min_height`, is part of an object: all its points are object points.
+    thin_cell: float = 0.01
+    thin_significance: float = 3.0  # [standard errors] one-sided: 0.13 % of the table's cells;
+    # alone they make no object (a cluster needs min_cluster_points voxels).
+    thin_min_height: float = 0.001  # [m] half the thinnest object to be seen (2 mm)
+    thin_min_cell_points: int = 6  # a cell with fewer points says nothing
+    # A raised cell's points never join an object the height threshold sees, unless that object
+    # lies flat: the median height of its points is below this [m] (a blade whose noise crosses
+    # the threshold here and there; a can's or a handle's is far above it).
+    thin_max_height: float = 0.01
     max_object_height: float = 0.6  # ... and at most this far [m].
     table_margin: float = 0.0  # objects' points may lie this far outside the table's extent [m].
     voxel_size: float = 0.004  # object points are averaged per voxel of this side [m] ...

@@ -79,7 +79,9 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
         p_W=transform(X_WT, c.p_T), n_W=rotate(X_WT, c.n_T), labels=parts.labels,
         visible=c.visible, X_WO=X_WO, extents=parts.extents, pose=pose.pose,
         pose_likelihood=pose.likelihood, pose_cue=pose.cue,
-        pose_end=None if pose.end is None else (pose.end.recess, pose.end.dome),
+        pose_end=None if pose.end is None else (
+            pose.end.recess, pose.end.dome, pose.end.rise, pose.end.rise_error,
+            *((np.nan, np.nan) if pose.wall is None else (pose.wall.narrowing, pose.wall.error))),
         part_probabilities=parts.probabilities, part_boxes=boxes,
         pregrasp_X_WG=X_WG, pregrasp_parts=grasp_parts, containment=None, is_tool=parts.is_tool,
         interior_seen=interior_seen(pose, parts.is_tool, cfg.pose))

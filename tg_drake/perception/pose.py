@@ -22,9 +22,14 @@ in order:
    object's own base (upside-down), told by its shape rather than by the outline: a lid is
    recessed below a rim by a band of depths; a base is flat, or domed up from its centre (a
    can's bottom). `closed_end` measures the recess and the dome [m]; a logistic model fitted on
-   perceived training views (`ClosedEndModel`, tools/calibrate_pose.py) decides ("lid" or
-   "base"). Without enough points on the top (an open top seen from the side) or without a
-   fitted model, the next cue decides.
+   perceived training views (`ClosedEndModel`, tools/calibrate_pose.py) reads a lid ("lid").
+   A flat base looks like any flat closed top (a block's, a box's), so what the model reads as a
+   base must show it by evidence other than the missing lid (`closed_end_decision`): the end
+   pushed in beyond its noise ("base": a can's bottom), or the wall narrowing from the table up
+   to the top beyond its noise (`wall_taper`, "rim": an open container rests on its rim, its
+   wider end); a flat end on a straight wall is taken as upright ("flat"). Without enough
+   points on the top (an open top seen from the side) or without a fitted model, the next cue
+   decides.
 6. Otherwise (closed and straight, like a can) the object is taken as upright: standing upright
    is the usual pose (the calibrated likelihood of this cue says how often that is wrong).
 
@@ -86,6 +91,16 @@ END_MIN_POINTS = 10
 # The highest points of the ring: this quantile of their heights (a rim's crest, above the side
 # wall's points in the band).
 END_CREST_QUANTILE = 0.9
+# A shape (a recess below the ring, a wall narrowing upwards) is told from noise when it exceeds
+# this many standard errors (one-sided, about 0.1 % of flat ends or straight walls exceed it).
+SHAPE_SIGNIFICANCE = 3.0
+# The side wall (`wall_taper`): points whose normal is within 60° of horizontal, in this many
+# height bins of at least this many points each.
+WALL_NORMAL_COSINE = 0.5
+# The end's own surface: points whose normal is within 60° of vertical.
+UP_NORMAL_COSINE = 0.5
+WALL_BINS = 8
+WALL_MIN_POINTS = 8
 
 
 @dataclass(frozen=True)
@@ -94,6 +109,18 @@ class ClosedEnd:
 
     recess: float  # the ring's crest above the centre: a recessed lid, a domed base, 0 if flat.
     dome: float  # the middle band above the centre: a domed end's rise, 0 if flat.
+    # The ring's median height above the centre's [m] and that difference's standard error [m]
+    # (from the spread of the heights: the sensor's noise on the end itself). A flat end (a
+    # solid's top, a container's flat base) has no rise beyond its noise; its crest (`recess`)
+    # then measures only the noise's upper quantile.
+    rise: float = 0.0
+    rise_error: float = 0.0
+
+    @property
+    def shaped(self) -> bool:
+        """The end is recessed below its ring beyond the noise (a lid below its rim, a base
+        pushed in): its shape says which end it is. A flat end says nothing of that."""
+        return self.rise > SHAPE_SIGNIFICANCE * self.rise_error
 
     def features(self) -> np.ndarray:
         """The closed-end model's features (`ClosedEndModel`): recess [mm], dome [mm] and
@@ -103,10 +130,12 @@ class ClosedEnd:
         return np.array([recess, dome, recess ** 2])
 
 
-def closed_end(c: Completion) -> ClosedEnd | None:
+def closed_end(c: Completion, n_visible_T: np.ndarray | None = None) -> ClosedEnd | None:
     """The shape of the closed end on top of a vertical object from its visible points, or None
     when the top band shows too few points at the centre, in the middle or on the ring (an open
-    top seen from the side, a narrow neck)."""
+    top seen from the side, a narrow neck). With the visible points' normals `n_visible_T`, the
+    ring's rise (`ClosedEnd.rise`) is measured on its upward-facing points only (the end's own
+    surface, not the side wall's points in the band)."""
     vis = c.visible & ~c.handle
     p = c.p_T[vis]
     if len(p) < 3 * END_MIN_POINTS:
@@ -115,6 +144,8 @@ def closed_end(c: Completion) -> ClosedEnd | None:
     band = z > z.max() - END_BAND
     r = np.linalg.norm(p[band, :2] - c.p_TA[:2], axis=1)
     zb = z[band]
+    facing_up = (np.ones(len(zb), bool) if n_visible_T is None else
+                 n_visible_T[~c.handle[c.visible]][band, 2] > UP_NORMAL_COSINE)
     r_end = float(np.quantile(r, RADIUS_QUANTILE)) if len(r) else 0.0
     centre = r < END_CENTRE * r_end
     middle = (r >= END_CENTRE * r_end) & (r < END_MIDDLE * r_end)
@@ -122,8 +153,80 @@ def closed_end(c: Completion) -> ClosedEnd | None:
     if min(centre.sum(), middle.sum(), ring.sum()) < END_MIN_POINTS:
         return None
     z_centre = float(np.median(zb[centre]))
+    top_ring = ring & facing_up
+    if top_ring.sum() >= END_MIN_POINTS:
+        rise = float(np.median(zb[top_ring])) - z_centre
+        rise_error = float(np.hypot(_median_error(zb[centre]), _median_error(zb[top_ring])))
+    else:  # no end surface on the ring: no shape seen
+        rise, rise_error = 0.0, np.inf
     return ClosedEnd(recess=float(np.quantile(zb[ring], END_CREST_QUANTILE)) - z_centre,
-                     dome=float(np.median(zb[middle])) - z_centre)
+                     dome=float(np.median(zb[middle])) - z_centre, rise=rise,
+                     rise_error=rise_error)
+
+
+def _median_error(x: np.ndarray) -> float:
+    """Standard error of the median of `x` [its unit]: 1.253·σ/√n, σ from the median absolute
+    deviation (1.4826·MAD, the normal's σ; robust to the few points of an edge)."""
+    sigma = 1.4826 * float(np.median(np.abs(x - np.median(x))))
+    return 1.2533 * sigma / np.sqrt(len(x))
+
+
+@dataclass(frozen=True)
+class WallTaper:
+    """How the side wall of a vertical object narrows upwards (`wall_taper`): the slope of its
+    radius against height, −dr/dz (> 0: narrower at the top), and its standard error."""
+
+    narrowing: float  # [m/m]
+    error: float  # [m/m]
+
+    @property
+    def significant(self) -> bool:
+        """The wall narrows upwards beyond its noise: the object rests on its wider end."""
+        return self.narrowing > SHAPE_SIGNIFICANCE * self.error
+
+
+def wall_taper(c: Completion, n_visible_T: np.ndarray) -> WallTaper | None:
+    """The visible side wall's narrowing upwards: the median radius (distance to the axis) of
+    the wall's points (normal within WALL_NORMAL_COSINE of horizontal) in WALL_BINS height bins
+    between the table and the top band, fitted by least squares against the bins' heights;
+    None with fewer than three bins of WALL_MIN_POINTS points (a squat object, a hidden wall).
+
+    An open container upside down meets the table with its rim, which is (nearly always) its
+    widest end: its wall narrows from the table up to the base on top. A solid standing on its
+    base (a block, a cylinder) keeps its width. Unlike the taper cue's end radii (one quantile
+    of each end's slice), the fit uses the whole wall and states its own noise, so it tells a
+    draft of a few degrees from a straight wall."""
+    vis = c.visible & ~c.handle
+    p = c.p_T[vis]
+    n = n_visible_T[~c.handle[c.visible]]
+    if len(p) < WALL_MIN_POINTS:
+        return None
+    z = p[:, 2]
+    wall = (np.abs(n[:, 2]) < WALL_NORMAL_COSINE) & (z < z.max() - END_BAND)
+    if wall.sum() < 3 * WALL_MIN_POINTS:
+        return None
+    zw = z[wall]
+    r = np.linalg.norm(p[wall, :2] - c.p_TA[:2], axis=1)
+    edges = np.linspace(zw.min(), zw.max(), WALL_BINS + 1)
+    k = np.clip(np.searchsorted(edges, zw, side="right") - 1, 0, WALL_BINS - 1)
+    zs, rs, es = [], [], []
+    for b in range(WALL_BINS):
+        m = k == b
+        if m.sum() >= WALL_MIN_POINTS:
+            zs.append(float(np.median(zw[m])))
+            rs.append(float(np.median(r[m])))
+            es.append(max(_median_error(r[m]), 1e-5))
+    if len(zs) < 3:
+        return None
+    zs, rs, w = np.array(zs), np.array(rs), 1.0 / np.array(es) ** 2
+    zm = np.sum(w * zs) / w.sum()
+    sxx = np.sum(w * (zs - zm) ** 2)
+    slope = np.sum(w * (zs - zm) * (rs - np.sum(w * rs) / w.sum())) / sxx
+    # The slope's error from the bins' scatter about the line (a wall that bends, or noise the
+    # medians' errors understate), at least the one the bins' errors give.
+    resid = rs - (np.sum(w * rs) / w.sum() + slope * (zs - zm))
+    chi2 = float(np.sum(w * resid ** 2)) / max(len(zs) - 2, 1)
+    return WallTaper(narrowing=-float(slope), error=float(np.sqrt(max(chi2, 1.0) / sxx)))
 
 
 @dataclass(frozen=True)
@@ -138,6 +241,24 @@ class ClosedEndModel:
     def p_upsidedown(self, end: ClosedEnd) -> float:
         x = float(np.dot(self.weights, end.features())) + self.bias
         return float(1.0 / (1.0 + np.exp(-x)))
+
+
+def closed_end_decision(model: ClosedEndModel, end: ClosedEnd, wall: WallTaper | None
+                        ) -> tuple[float, str]:
+    """(top sign, cue) of a closed end on top. The model reads the end's shape: a lid recessed
+    below its rim says upright ("lid"). What it reads as a base must show it by more than the
+    lack of a lid, since a flat closed top (a solid block's, a closed box's) looks like a flat
+    base: the end is pushed in beyond its noise (a can's bottom: "base"), or the wall narrows
+    from the table up (a container resting on its wider rim: "rim"). A flat end on a straight
+    wall says nothing of which end is up: upright, the usual pose ("flat"; its calibrated
+    likelihood says how often that is wrong)."""
+    if model.p_upsidedown(end) <= 0.5:
+        return 1.0, "lid"
+    if end.shaped:
+        return -1.0, "base"
+    if wall is not None and wall.significant:
+        return -1.0, "rim"
+    return 1.0, "flat"
 
 
 @dataclass(frozen=True)
@@ -195,11 +316,12 @@ class PoseEstimate:
     pose: str  # the decision: the axis first (vertical or not), then which end is the top.
     likelihood: dict[str, float]  # POSES entry → probability (sums to 1).
     top_sign: float  # +1 when the object's top is at the positive end of the axis, else −1.
-    cue: str  # the cue that placed the top: "cavity", "handle", "neck", "lid", "base",
-    # "taper", "straight", or "ends".
+    cue: str  # the cue that placed the top: "cavity", "handle", "neck", "taper", "lid",
+    # "base", "rim", "flat", "straight", or "ends".
     inward_points: int = 0  # visible body points whose normal points into the object ...
     inward_share: float = 0.0  # ... and their share of the visible body points.
-    end: ClosedEnd | None = None  # the closed end on top, when the decision reached that cue.
+    end: ClosedEnd | None = None  # the closed end on top, when the decision reached that cue ...
+    wall: WallTaper | None = None  # ... and its side wall's narrowing upwards.
 
 
 def inward_facing(p: np.ndarray, n: np.ndarray, p_A: np.ndarray, a: np.ndarray) -> np.ndarray:
@@ -281,7 +403,7 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
     """
     cfg = cfg or PoseConfig()
     calibration = load_pose_calibration(cfg.calibration)
-    end = None
+    end = wall = None
     vis = c.visible & ~c.handle
     p_vis = c.p_T[vis]
     inward = inward_facing(p_vis, n_visible_T[~c.handle[c.visible]], c.p_TA, c.axis_T)
@@ -300,11 +422,13 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
         elif r_high < cfg.taper_ratio * r_low and (r_mid < cfg.taper_body_ratio * r_low
                                                    or r_high < cfg.strong_taper_ratio * r_low):
             top_sign, cue = -1.0, "taper"
-        elif (end := closed_end(c)) is not None and calibration.closed_end is not None:
-            upside_down = calibration.closed_end.p_upsidedown(end) > 0.5
-            top_sign, cue = (-1.0, "base") if upside_down else (1.0, "lid")
-        else:
-            top_sign, cue = 1.0, "straight"
+        else:  # the closed end (measured with or without a model: the calibration's input)
+            end = closed_end(c, n_visible_T)
+            wall = None if end is None else wall_taper(c, n_visible_T)
+            if end is not None and calibration.closed_end is not None:
+                top_sign, cue = closed_end_decision(calibration.closed_end, end, wall)
+            else:
+                top_sign, cue = 1.0, "straight"
     else:
         if cavity:
             top_sign = 1.0 if (p_TC - c.p_TA) @ c.axis_T >= 0 else -1.0
@@ -320,4 +444,5 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
     likelihood = calibration.likelihood(pose, cue)
     total = sum(likelihood.values())
     return PoseEstimate(pose, {k: likelihood[k] / total for k in POSES}, top_sign, cue,
-                        int(inward.sum()), float(inward.mean()) if len(inward) else 0.0, end)
+                        int(inward.sum()), float(inward.mean()) if len(inward) else 0.0, end,
+                        wall)

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import open3d as o3d
+from scipy.spatial import cKDTree
 
 from tg_drake.errors import PerceptionError
 from tg_drake.perception.config import SegmentationConfig
@@ -111,6 +112,73 @@ def find_table(p_W: np.ndarray, p_WC: np.ndarray, cfg: SegmentationConfig
         f"{cfg.min_table_fraction:.0%} of the {len(p_W)} points (planes tried, tilt: {tried})")
 
 
+def raised_cells(p_T: np.ndarray, height: np.ndarray, range_m: np.ndarray,
+                 table: np.ndarray, cfg: SegmentationConfig) -> np.ndarray:
+    """(N,) bool: the low points (−plane_distance < height ≤ min_object_height) that lie in a
+    raised cell of the table — an object thinner than the height threshold (a blade lying flat).
+
+    A point's height says little about a 2–4 mm object: the table's own noise is about as large
+    (σ ≈ 2 mm at 1 m through the D415). The median height of the points in a `thin_cell` square
+    has a far smaller error, 1.253·σ/√n. The noise is the table's own: a triangulating camera's
+    axial noise grows with range² (sensor_model.StructuredLight.axial_rms), so σ = a·range²
+    with a from the table inliers' heights (`table`: their mask; 1.4826·MAD of height/range²),
+    whatever the camera. A cell is raised when its median exceeds `thin_significance` of those
+    errors and `thin_min_height`; a lone raised cell of noise is dropped later (too few voxels
+    for a cluster).
+
+    Args:
+        p_T: (N, 3) points in the table frame [m]; height: (N,) their heights [m];
+        range_m: (N,) their distances from the camera [m]; table: (N,) bool, the plane's inliers.
+    """
+    low = np.flatnonzero((height <= cfg.min_object_height) & (height > -cfg.plane_distance))
+    out = np.zeros(len(p_T), bool)
+    if len(low) == 0 or not table.any():
+        return out
+    u = height[table] / range_m[table] ** 2
+    a = 1.4826 * float(np.median(np.abs(u - np.median(u))))  # [1/m] σ = a·range²
+    ij = np.floor(p_T[low, :2] / cfg.thin_cell).astype(np.int64)
+    ij -= ij.min(axis=0)
+    cell = ij[:, 0] * (int(ij[:, 1].max()) + 1) + ij[:, 1]
+    order = np.lexsort((height[low], cell))
+    cell_sorted = cell[order]
+    starts = np.flatnonzero(np.r_[True, cell_sorted[1:] != cell_sorted[:-1]])
+    counts = np.diff(np.r_[starts, len(order)])
+    median = height[low][order][starts + (counts - 1) // 2]
+    mean_r2 = np.add.reduceat(range_m[low][order] ** 2, starts) / counts
+    error = 1.2533 * a * mean_r2 / np.sqrt(counts)
+    raised = ((counts >= cfg.thin_min_cell_points) & (median > cfg.thin_min_height)
+              & (median > cfg.thin_significance * error))
+    if not raised.any():
+        return out
+    # The object's outline within a cell: each low point of a raised cell or of a cell next to
+    # one is tested on the disc of the cell's area centred on it (a point off the object's edge
+    # has mostly table around it), so that no cell's table part joins the object.
+    cells = cell_sorted[starts]
+    width = int(ij[:, 1].max()) + 1
+    near = np.zeros(len(cells), bool)
+    raised_ids = cells[raised]
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            near |= np.isin(cells, raised_ids + di * width + dj)
+    cand = order[np.repeat(near, counts)]
+    xy = p_T[low[cand], :2]
+    tree = cKDTree(xy)
+    hood = tree.query_ball_point(xy, cfg.thin_cell / np.sqrt(np.pi))
+    h, r2 = height[low[cand]], range_m[low[cand]] ** 2
+    n = np.array([len(nb) for nb in hood])
+    owner = np.repeat(np.arange(len(cand)), n)
+    nb = np.concatenate(hood).astype(int)
+    by = np.lexsort((h[nb], owner))  # each disc's heights in order
+    first = np.r_[0, np.cumsum(n)[:-1]]
+    hs = h[nb][by]
+    m = 0.5 * (hs[first + (n - 1) // 2] + hs[first + n // 2])  # each disc's median
+    error = 1.2533 * a * np.bincount(owner, weights=r2[nb], minlength=len(cand)) / n / np.sqrt(n)
+    keep = ((n >= cfg.thin_min_cell_points) & (m > cfg.thin_min_height)
+            & (m > cfg.thin_significance * error))
+    out[low[cand[keep]]] = True
+    return out
+
+
 def _merge_occluded(labels_px: np.ndarray, p_px: np.ndarray, rows: np.ndarray, cols: np.ndarray,
                     image_size: tuple[int, int], n: int, max_gap: float) -> np.ndarray:
     """Cluster id → merged cluster id, joining clusters that touch in the image (within 2 px)
@@ -142,6 +210,40 @@ def _merge_occluded(labels_px: np.ndarray, p_px: np.ndarray, rows: np.ndarray, c
     for i in range(n):  # flatten (parents have smaller ids)
         parent[i] = parent[parent[i]]
     return parent
+
+
+def _clusters(idx: np.ndarray, p_T: np.ndarray, pixels: np.ndarray,
+              image_size: tuple[int, int], cfg: SegmentationConfig
+              ) -> list[tuple[np.ndarray, bool, np.ndarray]]:
+    """The object clusters of the points `idx` (indices into p_T (N, 3) [m] and their image
+    pixels (N, 2)): per cluster (its voxel-averaged points, whether it touches the image border,
+    the indices of its points)."""
+    if len(idx) < cfg.min_cluster_points:
+        return []
+    p = p_T[idx]
+    width, height_px = image_size
+    m = cfg.border_margin_px
+    r, c = pixels[idx, 0], pixels[idx, 1]
+    border = (r < m) | (c < m) | (r >= height_px - m) | (c >= width - m)
+    q, voxel = voxel_average(p, cfg.voxel_size)
+    voxel_cut = np.bincount(voxel, weights=border, minlength=len(q)) > 0
+    labels = np.asarray(o3d.geometry.PointCloud(o3d.utility.Vector3dVector(q)).cluster_dbscan(
+        cfg.cluster_eps, cfg.cluster_min_points))
+    n_clusters = int(labels.max()) + 1
+    if n_clusters > 1:
+        keep_px = labels[voxel] >= 0
+        merged = _merge_occluded(labels[voxel][keep_px], p[keep_px], r[keep_px], c[keep_px],
+                                 image_size, n_clusters, cfg.merge_max_gap)
+        labels = np.where(labels >= 0, merged[labels], -1)
+    order = np.argsort(labels, kind="stable")
+    bounds = np.searchsorted(labels[order], np.arange(n_clusters + 1))
+    out = []
+    for k in range(n_clusters):
+        members = order[bounds[k]:bounds[k + 1]]
+        if len(members) >= cfg.min_cluster_points:
+            out.append((q[members], bool(voxel_cut[members].any()),
+                        idx[np.isin(voxel, members)]))
+    return out
 
 
 def segment_cloud(p_W: np.ndarray, pixels: np.ndarray, image_size: tuple[int, int],
@@ -179,43 +281,45 @@ def segment_cloud(p_W: np.ndarray, pixels: np.ndarray, image_size: tuple[int, in
     lo = np.percentile(table_T[:, :2], 0.5, axis=0) - cfg.table_margin
     hi = np.percentile(table_T[:, :2], 99.5, axis=0) + cfg.table_margin
 
-    # Object points: above the plane, over the table.
-    above = np.flatnonzero((height > cfg.min_object_height) & (height < cfg.max_object_height))
-    p_T = transform(X_TW, p_W[above])
-    inside = np.all(p_T[:, :2] >= lo, axis=1) & np.all(p_T[:, :2] <= hi, axis=1)
-    p_T, above = p_T[inside], above[inside]
-    width, height_px = image_size
-    m = cfg.border_margin_px
-    r, c = pixels[above, 0], pixels[above, 1]
-    border = (r < m) | (c < m) | (r >= height_px - m) | (c >= width - m)
+    # Object points: above the plane, over the table; then the objects thinner than the height
+    # threshold (`raised_cells`), as objects of their own: a raised cell's points never join an
+    # object the threshold sees (its lowest band stays cut, as the kernel database's views and
+    # the pose calibration saw it: the table's mixed pixels at its foot are not the object).
+    p_T_all = transform(X_TW, p_W)
+    inside = np.all(p_T_all[:, :2] >= lo, axis=1) & np.all(p_T_all[:, :2] <= hi, axis=1)
+    regular = inside & (height > cfg.min_object_height) & (height < cfg.max_object_height)
+    found = _clusters(np.flatnonzero(regular), p_T_all, pixels, image_size, cfg)
+    thin = inside & raised_cells(p_T_all, height, np.linalg.norm(p_W - p_WC, axis=1),
+                                 np.abs(height) < cfg.plane_distance, cfg)
+    if thin.any():
+        # A found object lying within thin_max_height of the table (its threshold-crossing
+        # points a thin object's noise) is clustered again with the raised cells' points.
+        flat = np.zeros(len(p_W), bool)
+        for q, _, members in found:
+            flat[members] = np.median(q[:, 2]) <= cfg.thin_max_height
+        found = [f for f in found if not flat[f[2][0]]]
+        taken = np.zeros(len(p_W), bool)
+        for _, _, members in found:
+            taken[members] = True
+        rest = np.flatnonzero((regular & ~taken) | thin)
+        if taken.any() and len(rest):  # nothing within a cluster's reach of a found object
+            d, _ = cKDTree(p_T_all[taken]).query(p_T_all[rest],
+                                                 distance_upper_bound=cfg.cluster_eps)
+            rest = rest[~np.isfinite(d)]
+        found += [f for f in _clusters(rest, p_T_all, pixels, image_size, cfg)
+                  if (thin | flat)[f[2]].any()]
     objects: list[np.ndarray] = []
     cut: list[bool] = []
     n_dropped = 0
-    if len(p_T) >= cfg.min_cluster_points:
-        q, voxel = voxel_average(p_T, cfg.voxel_size)
-        voxel_cut = np.bincount(voxel, weights=border, minlength=len(q)) > 0
-        labels = np.asarray(o3d.geometry.PointCloud(o3d.utility.Vector3dVector(q)).cluster_dbscan(
-            cfg.cluster_eps, cfg.cluster_min_points))
-        n_clusters = int(labels.max()) + 1
-        if n_clusters > 1:
-            keep_px = labels[voxel] >= 0
-            merged = _merge_occluded(labels[voxel][keep_px], p_T[keep_px], r[keep_px],
-                                     c[keep_px], image_size, n_clusters, cfg.merge_max_gap)
-            labels = np.where(labels >= 0, merged[labels], -1)
-        order = np.argsort(labels, kind="stable")
-        bounds = np.searchsorted(labels[order], np.arange(n_clusters + 1))
-        clusters = [order[bounds[k]:bounds[k + 1]] for k in range(n_clusters)]
-        clusters = [c for c in clusters if len(c) >= cfg.min_cluster_points]
-        # Deterministic order: by the cluster's centroid x, then y, in the table frame.
-        centroids = np.array([q[c].mean(axis=0) for c in clusters]).reshape(-1, 3)
-        for k in np.lexsort((centroids[:, 1], centroids[:, 0])):
-            members = clusters[k]
-            is_cut = bool(voxel_cut[members].any())
-            if is_cut and cfg.drop_border_objects:
-                n_dropped += 1
-                continue
-            objects.append(q[members])
-            cut.append(is_cut)
+    # Deterministic order: by the cluster's centroid x, then y, in the table frame.
+    centroids = np.array([q.mean(axis=0) for q, _, _ in found]).reshape(-1, 3)
+    for k in np.lexsort((centroids[:, 1], centroids[:, 0])):
+        q, is_cut, _ = found[k]
+        if is_cut and cfg.drop_border_objects:
+            n_dropped += 1
+            continue
+        objects.append(q)
+        cut.append(is_cut)
     if not objects and n_dropped:
         raise PerceptionError(
             f"every object on the table ({n_dropped}) is cut by the image border; move the "
