@@ -1,6 +1,8 @@
 """The task motions' geometry on arrays: turns into a resting pose, the retreat after a turn,
 surfaces in the world, the task's placing."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -68,6 +70,10 @@ def test_a_turn_that_would_leave_the_object_on_the_lower_finger_is_not_placed():
     # Turned upside down by the wrist, the closing axis stays level: that turn is kept.
     (flip, *_) = turns_to_pose(UPRIGHT, R_SIDE, "upsidedown", is_tool=False)
     assert lets_go_onto_support(flip, R_SIDE)
+    # A place-and-regrasp's exact intermediate orientation is refused on the same ground.
+    exact = dataclasses.replace(placing, R_place=tuple(map(tuple, wrist)))
+    assert exact.place_poses(np.eye(4), R_SIDE, [0.06, 0.06, 0.12], is_tool=False,
+                             release_height=0.01, place_pose=place_pose) == []
 
 
 def test_the_retreat_after_a_turn_never_goes_down():
