@@ -1,6 +1,8 @@
 """The task motions' geometry on arrays: turns into a resting pose, the retreat after a turn,
 surfaces in the world, the task's placing."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -8,6 +10,7 @@ from tg_drake.errors import ScenarioError
 from tg_drake.planning.planner import place_pose
 from tg_drake.planning.task_motion import (
     TaskMotionConfig,
+    lets_go_onto_support,
     perceived_pose,
     surfaces_in_world,
     task_placing,
@@ -48,6 +51,29 @@ def test_in_the_pose_already_no_turn_and_a_tool_only_lies_flat():
                                                               is_tool=False)] == [True]
     assert turns_to_pose(UPRIGHT, R_TOP, "upright", is_tool=True) == []
     assert len(turns_to_pose(UPRIGHT, R_TOP, "sideways", is_tool=True)) == 1
+
+
+def test_a_turn_that_would_leave_the_object_on_the_lower_finger_is_not_placed():
+    """An upright can in a side grasp laid sideways by the wrist alone turns the closing axis
+    vertical (a finger under the can: opening lowers it onto that finger); the placing keeps
+    only the turns whose closing axis stays nearer level than vertical."""
+    (wrist, *_) = turns_to_pose(UPRIGHT, R_SIDE, "sideways", is_tool=False)
+    assert abs((wrist @ R_SIDE[:, 0])[2]) > 0.99 and not lets_go_onto_support(wrist, R_SIDE)
+    placing = task_placing("p&pInSideways", place_xy=(0.75, -0.3), table_z=0.0)
+    poses = placing.place_poses(np.eye(4), R_SIDE, [0.06, 0.06, 0.12], is_tool=False,
+                                release_height=0.01, place_pose=place_pose)
+    assert poses
+    for R, X in poses:
+        x_G = R @ R_SIDE[:, 0]
+        assert abs(x_G[2]) <= np.cos(np.pi / 4) + 1e-9  # the fingers open sideways
+        assert perceived_pose(X[:3, :3], is_tool=False) == "sideways"
+    # Turned upside down by the wrist, the closing axis stays level: that turn is kept.
+    (flip, *_) = turns_to_pose(UPRIGHT, R_SIDE, "upsidedown", is_tool=False)
+    assert lets_go_onto_support(flip, R_SIDE)
+    # A place-and-regrasp's exact intermediate orientation is refused on the same ground.
+    exact = dataclasses.replace(placing, R_place=tuple(map(tuple, wrist)))
+    assert exact.place_poses(np.eye(4), R_SIDE, [0.06, 0.06, 0.12], is_tool=False,
+                             release_height=0.01, place_pose=place_pose) == []
 
 
 def test_the_retreat_after_a_turn_never_goes_down():

@@ -332,9 +332,13 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         if handover is not None:  # a pass: handed over in the air (planning.handover)
             places = [(None, X) for X in _place_variants(handover.object_pose(X_WO), config)]
         if not places:
+            # A tool rests only flat; any other object's turns were refused because its fingers
+            # would carry it at the release: a place-and-regrasp may do (TURNED_IN_HAND).
+            why = ("" if target.is_tool else
+                   f" with the fingers letting go, {TURNED_IN_HAND} {placing.pose} in the hand")
             costs[i] = np.inf
             reasons[i] = _farthest(reasons[i], f"place pose: {target_name(target)} cannot "
-                                   f"be turned to rest {placing.pose}")
+                                   f"be turned to rest {placing.pose}{why}")
             continue
         pours, why = _pours(placing, obstacles, target, X_WG)
         if not pours:

@@ -10,8 +10,9 @@
   object about its box centre, about the horizontal part of the gripper's approach axis first
   (a turn of the wrist alone) then about that of its closing axis, else the smallest turn. The
   perceived object frame has z along the symmetry axis towards the top, so upright is z up,
-  upside down z down, sideways z level. A tool only lies "sideways" (flat): any other pose is
-  refused.
+  upside down z down, sideways z level. A turn that leaves the gripper's closing axis nearer
+  vertical than level is not placed (`lets_go_onto_support`: the lower finger would carry it).
+  A tool only lies "sideways" (flat): any other pose is refused.
 - p&pOn: the object goes to the centre of the surface (`SurfaceConfig`), its box's lowest corner
   `release_height` above the surface's top; the surfaces are obstacles of every motion.
 - pourOut: carried upright over the bowl (`task.pour_into`, the perceived object nearest the
@@ -40,6 +41,10 @@ from tg_drake.tasks.judge import REST_POSE_OF_TASK
 UP = np.array([0.0, 0.0, 1.0])
 # [1] a turn axis is taken as perpendicular to the object's axis when their cosine is below this.
 PERPENDICULAR = 0.15
+# [1] a turned object is released only where the gripper's closing axis x_G is nearer level than
+# vertical (|x_G · z_W| at most cos 45°): nearer vertical, the lower finger lies between the object
+# and the table, and opening lowers the object onto that finger instead of setting it down.
+MAX_CLOSING_RISE = float(np.cos(np.pi / 4))
 
 
 @dataclass
@@ -161,6 +166,16 @@ def smallest_turn(R_WO: np.ndarray, pose: str, *, is_tool: bool) -> np.ndarray |
     return turns[-1] if turns else None
 
 
+def lets_go_onto_support(R_turn: np.ndarray, R_WG: np.ndarray) -> bool:
+    """Can a gripper at R_WG that turns its object by the world rotation R_turn (the grasp kept,
+    so the gripper turns with it) set it down by opening? Its fingers open along its closing
+    axis x_G; with x_G nearer vertical than level at the place (`MAX_CLOSING_RISE`) the lower
+    finger stays under the object, which then rests on the finger, not on the table. A turn
+    about the vertical does not change this, so the place's yaw variants share the answer."""
+    x_place = np.asarray(R_turn, float) @ np.asarray(R_WG, float)[:, 0]
+    return abs(float(x_place @ UP)) <= MAX_CLOSING_RISE + 1e-9
+
+
 def turned_retreat(y_WG: np.ndarray) -> np.ndarray:
     """The unit direction a gripper backs away in after releasing an object it turned: back along
     its approach (−y_G), but never down (a turned object's approach may point up, and backing
@@ -251,11 +266,14 @@ class TaskPlacing:
         object cannot be turned into the pose. `place_pose` is the planner's
         (`tg_drake.planning.planner.place_pose`)."""
         X_WO = np.asarray(X_WO, float)
+        R_WG = np.asarray(X_WG, float)[:3, :3]
         if self.R_place is not None:  # an exact orientation: one turn, each release height
             R = np.asarray(self.R_place, float) @ X_WO[:3, :3].T
             if np.allclose(R, np.eye(3), atol=1e-9):
                 return [(None, place_pose(X_WO, extents, self.place_xy, table_z=self.support_z,
                                           release_height=release_height))]
+            if not lets_go_onto_support(R, R_WG):
+                return []
             return [(R, place_pose(turned(X_WO, R), extents, self.place_xy,
                                    table_z=self.support_z, release_height=height))
                     for height in self.turned_release_heights]
@@ -271,12 +289,13 @@ class TaskPlacing:
                                              release_height=release_height)))
             return out
         out = []
-        for R in turns_to_pose(X_WO[:3, :3], np.asarray(X_WG, float)[:3, :3], self.pose,
-                               is_tool=is_tool):
+        for R in turns_to_pose(X_WO[:3, :3], R_WG, self.pose, is_tool=is_tool):
             if np.allclose(R, np.eye(3)):
                 out.append((None, place_pose(X_WO, extents, self.place_xy,
                                              table_z=self.support_z,
                                              release_height=release_height)))
+                continue
+            if not lets_go_onto_support(R, R_WG):  # it would rest on the lower finger
                 continue
             for height in self.turned_release_heights:
                 out.append((R, place_pose(turned(X_WO, R), extents, self.place_xy,
