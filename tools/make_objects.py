@@ -542,7 +542,14 @@ def mass_properties(V, F, density, pieces=()) -> MassProperties:
     com = first / mass
     J = second - mass * np.outer(com, com)  # ∫ (x-c)(x-c)ᵀ dm
     inertia = np.trace(J) * np.eye(3) - J
+    # Entries below the sums' rounding (double precision over ~10⁴ faces: 1e-12 of the trace) are
+    # zero: a symmetric solid's products of inertia, which otherwise come out as ±1e-20 noise that
+    # differs with the NumPy/BLAS build and keeps the files from being reproduced bit for bit.
+    inertia[np.abs(inertia) < INERTIA_ROUNDING * np.trace(inertia)] = 0.0
     return MassProperties(mass, matvol, com, inertia)
+
+
+INERTIA_ROUNDING = 1e-12  # relative to the trace of the inertia
 
 
 # ------------------------------------------------------------------------------------------------
