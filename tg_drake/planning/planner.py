@@ -51,7 +51,12 @@ from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.grasping.feasibility import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.logic.receive import receiver_parts
-from tg_drake.planning.handover import Handover, choose_receiver_grasp, receiver_motion
+from tg_drake.planning.handover import (
+    Handover,
+    choose_receiver_grasp,
+    handover_object_poses,
+    receiver_motion,
+)
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.task_motion import (
     TaskPlacing,
@@ -329,8 +334,17 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         found = False
         places = _task_place_variants(X_WO_place, config, placing=placing, X_WO=X_WO,
                                       X_WG=X_WG, extents=target.extents, is_tool=target.is_tool)
-        if handover is not None:  # a pass: handed over in the air (planning.handover)
-            places = [(None, X) for X in _place_variants(handover.object_pose(X_WO), config)]
+        if handover is not None:  # a pass: handed over in the air (planning.handover), where
+            # the arm can reach with this grasp
+            places = [(None, X) for X in handover_object_poses(
+                handover, X_WO, X_WG, yaws_deg=config.place_yaws, lift=config.lift_height,
+                retreat=config.retreat_distance)]
+            if not places:
+                costs[i] = np.inf
+                reasons[i] = _farthest(reasons[i], "pre-place pose: the hand-over points are out "
+                                       "of the arm's reach with this grasp (its wrist outside "
+                                       "the shell joint 4 allows)")
+                continue
         if not places:
             costs[i] = np.inf
             reasons[i] = _farthest(reasons[i], f"place pose: {target_name(target)} cannot "
