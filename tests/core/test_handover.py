@@ -10,10 +10,12 @@ from tg_drake.planning.handover import (
     Handover,
     ReceiverConfig,
     choose_receiver_grasp,
+    handover_object_poses,
     mount_configuration,
     mount_pose,
     receiver_motion,
     robot_gripper_points,
+    wrist_reach_margin,
 )
 from tg_drake.tasks.judge import PASS_HEIGHT_TOLERANCE, judge_pass
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription
@@ -205,3 +207,48 @@ def test_a_turned_receiver_grasp_keeps_its_grasp_point_and_closes_across_the_app
         assert np.allclose(V[:3, 3] + GRASP_DEPTH * V[:3, 1], [-0.07, 0.0, 0.3])
         assert np.allclose(V[:3, 2], X[:3, 2])  # the pads' width axis kept
         assert abs(V[:3, 0] @ X[:3, 1]) == pytest.approx(1.0)  # closes along the old approach
+
+
+def side_grasp(p, approach) -> np.ndarray:
+    """A WSG frame at p approaching horizontally along `approach` (fingers closing across it, the
+    pads' width vertical)."""
+    y = np.asarray(approach, float) / np.linalg.norm(approach)
+    z = np.array([0.0, 0.0, 1.0])
+    X = np.eye(4)
+    X[:3, :3] = np.column_stack([np.cross(y, z), y, z])
+    X[:3, 3] = p
+    return X
+
+
+def test_the_wrist_reach_margin_is_the_distance_inside_the_arms_shell():
+    # The shoulder at 0.36 m above the base; the wrist centre 0.195 m behind G; the elbow's
+    # ±120° range leaves the wrist 0.41–0.82 m from the shoulder.
+    far = side_grasp([0.6 + 0.195, 0.0, 0.36], [1.0, 0.0, 0.0])  # wrist 0.6 m out
+    assert wrist_reach_margin(far) == pytest.approx(0.6 - 0.4104, abs=1e-3)  # the nearer bound
+    folded = side_grasp([0.3 + 0.195, 0.0, 0.36], [1.0, 0.0, 0.0])  # wrist 0.3 m out
+    assert wrist_reach_margin(folded) == pytest.approx(0.3 - 0.4104, abs=1e-3)
+    stretched = side_grasp([0.9 + 0.195, 0.0, 0.36], [1.0, 0.0, 0.0])
+    assert wrist_reach_margin(stretched) == pytest.approx(0.82 - 0.9, abs=1e-3)
+
+
+def test_hand_over_points_out_of_the_arms_reach_for_the_grasp_are_left_out():
+    # An upright can held from the robot's side (approach +x) at the default hand-over point
+    # (0.6 m out, 0.3 m up): the wrist 0.25 m from the shoulder, inside the folded arm's reach;
+    # the point moved out and turned yaws that bring the wrist out of the fold remain.
+    handover = Handover(ReceiverConfig(), np.array([[1, 0, 0, 0.75], [0, 1, 0, 0],
+                                                    [0, 0, 1, 0], [0, 0, 0, 1.0]]))
+    X_WO = np.eye(4)
+    X_WO[:3, 3] = [0.7, 0.0, 0.06]
+    X_WG = side_grasp([0.7 - 0.055, 0.0, 0.07], [1.0, 0.0, 0.0])
+    poses = handover_object_poses(handover, X_WO, X_WG, yaws_deg=[0.0, 60.0, 180.0], lift=0.15,
+                                  retreat=0.1)
+    assert poses
+    for X in poses:
+        G = X @ np.linalg.inv(X_WO) @ X_WG
+        assert wrist_reach_margin(G) >= 0.0
+    at_point = [X for X in poses if np.allclose(X[:3, 3], handover.point)]
+    yawed_0 = [X for X in at_point if np.allclose(X[:3, :3], np.eye(3))]
+    assert not yawed_0  # held from the robot's side, straight at the point: too folded
+    assert wrist_reach_margin(handover.object_pose(X_WO) @ np.linalg.inv(X_WO) @ X_WG) < 0.0
+    # Some pose of the list lies out along the robot's radial direction from the point.
+    assert any(X[0, 3] > handover.point[0] + 0.05 for X in poses)

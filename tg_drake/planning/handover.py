@@ -51,7 +51,7 @@ from tg_drake.grasping.feasibility import (
     grasp_feasibility,
     gripper_boxes,
 )
-from tg_drake.robot import WSG_MAX_OPENING
+from tg_drake.robot import IIWA_JOINTS, WSG_MAX_OPENING, X_7G_XYZ
 from tg_drake.tasks.judge import PASS_HOLD_DURATION
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription
 
@@ -73,6 +73,12 @@ class ReceiverConfig:
     rise: float = 0.45  # [m] ... and this far above it
     reach: float = 0.8  # [m] its mount moves at most this far from where it waits
     approach: float = 0.1  # [m] its pre-grasp stands this far back along −y_R from its grasp
+    offsets: list[list[float]] = field(default_factory=lambda: [
+        [0.0, 0.0], [0.1, 0.0], [0.2, 0.0], [0.1, 0.1], [-0.1, 0.0]])  # [m] (out, up): the
+    # hand-over points tried in order (`handover_object_poses`), moved `out` horizontally away
+    # from the robot's base and `up` from `xy`/`height`, for a grasp whose wrist cannot reach
+    # the configured one (a side grasp from the robot's side puts the wrist inside the arm's
+    # folded reach; the receiver's reach still bounds its grasp there)
     max_approach_angle: float = 90.0  # [deg] its approach +y_R at most this far from its
     # direction (90: any approach from its side of the object, from above included)
     max_grasps: int = 48  # of those, the best by P(part) · P(grasp | local shape) checked by the
@@ -101,6 +107,10 @@ class ReceiverConfig:
         if len(self.xy) != 2 or not all(math.isfinite(v) for v in self.xy):
             raise ScenarioError(f"xy must be two finite numbers [m], got {self.xy}",
                                 field=f"{where}.xy")
+        if not self.offsets or any(len(o) != 2 or not all(math.isfinite(v) for v in o)
+                                   for o in self.offsets):
+            raise ScenarioError(f"offsets must be a non-empty list of [out, up] pairs of finite "
+                                f"numbers [m], got {self.offsets}", field=f"{where}.offsets")
         checks = (("height", self.height > 0.0, "> 0 m"), ("yaw", math.isfinite(self.yaw),
                                                            "a finite angle [deg]"),
                   ("standoff", self.standoff >= 0.0, ">= 0 m"), ("rise", self.rise >= 0.0,
@@ -221,6 +231,61 @@ class Handover:
         X = np.array(X_WO, float)
         X[:3, 3] = self.point
         return X
+
+
+def _arm_shell() -> tuple[np.ndarray, float, float, float]:
+    """The iiwa's shoulder centre (3,) [m] in the world (its base at the origin, joint 1 along z),
+    the shortest and longest distances [m] from it to the wrist centre (link 6's origin, where
+    joints 5–7 meet) that joint 4's range allows, and the wrist centre's offset [m] back along −y_G
+    from the WSG frame G: all from the robot's kinematic table (tg_drake.robot)."""
+    j = IIWA_JOINTS
+    shoulder = np.array([0.0, 0.0, j[0].xyz[2] + j[1].xyz[2]])
+    upper = abs(j[2].xyz[1]) + abs(j[3].xyz[2])  # joint 2 → joint 4 (elbow)
+    fore = abs(j[4].xyz[1]) + abs(j[5].xyz[2])  # joint 4 → joint 6 (wrist centre)
+    bend = j[3].limit  # [rad] the elbow's largest bend from straight
+    shortest = math.sqrt(upper ** 2 + fore ** 2 - 2 * upper * fore * math.cos(math.pi - bend))
+    return shoulder, shortest, upper + fore, abs(j[6].xyz[1]) + X_7G_XYZ[2]
+
+
+def wrist_reach_margin(X_WG: np.ndarray) -> float:
+    """[m] how far inside the iiwa's reachable shell (`_arm_shell`) the wrist centre of gripper pose
+    X_WG lies: negative when no joint configuration within joint 4's range puts the gripper
+    there, whatever the other joints (a necessary condition of the IK, not a sufficient one)."""
+    shoulder, shortest, longest, wrist_g = _arm_shell()
+    X = np.asarray(X_WG, float)
+    d = float(np.linalg.norm(X[:3, 3] - wrist_g * X[:3, 1] - shoulder))
+    return min(d - shortest, longest - d)
+
+
+def handover_object_poses(handover: "Handover", X_WO: np.ndarray, X_WG: np.ndarray, *,
+                          yaws_deg, lift: float, retreat: float) -> list[np.ndarray]:
+    """The object's poses at the hand-over to plan for grasp X_WG (picked with the object at X_WO):
+    its box centre at each of the receiver's `offsets` from the configured point (out: along the
+    horizontal from the robot's base through it), its orientation turned about the vertical by
+    each of `yaws_deg` [deg] (the planner's place yaws), in that order (the configured point's
+    yaws first); those whose gripper pose there, `lift` [m] above it (the pre-place) or `retreat`
+    [m] back along −y_G (the retreat) would put the wrist outside the arm's reach
+    (`wrist_reach_margin` < 0) left out: the IK cannot find them."""
+    X_WO = np.asarray(X_WO, float)
+    X_OG = np.linalg.inv(X_WO) @ np.asarray(X_WG, float)
+    point = handover.point
+    out_dir = np.array([point[0], point[1], 0.0])
+    norm = float(np.linalg.norm(out_dir))
+    out_dir = out_dir / norm if norm > 1e-9 else handover.direction * -1.0
+    poses = []
+    for out, up in handover.config.offsets:
+        p = point + out * out_dir + up * UP
+        for yaw in np.deg2rad(np.asarray(yaws_deg, float)):
+            X = X_WO.copy()
+            X[:3, :3] = _rz(float(yaw)) @ X_WO[:3, :3]
+            X[:3, 3] = p
+            G = X @ X_OG
+            pre, back = G.copy(), G.copy()
+            pre[2, 3] += lift
+            back[:3, 3] -= retreat * G[:3, 1]
+            if min(wrist_reach_margin(V) for V in (G, pre, back)) >= 0.0:
+                poses.append(X)
+    return poses
 
 
 def robot_gripper_points(X_WG: np.ndarray, *, retreat: float, spacing: float = 0.005

@@ -51,7 +51,12 @@ from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.grasping.feasibility import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.logic.receive import receiver_parts
-from tg_drake.planning.handover import Handover, choose_receiver_grasp, receiver_motion
+from tg_drake.planning.handover import (
+    Handover,
+    choose_receiver_grasp,
+    handover_object_poses,
+    receiver_motion,
+)
 from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.task_motion import (
     TaskPlacing,
@@ -329,8 +334,17 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         found = False
         places = _task_place_variants(X_WO_place, config, placing=placing, X_WO=X_WO,
                                       X_WG=X_WG, extents=target.extents, is_tool=target.is_tool)
-        if handover is not None:  # a pass: handed over in the air (planning.handover)
-            places = [(None, X) for X in _place_variants(handover.object_pose(X_WO), config)]
+        if handover is not None:  # a pass: handed over in the air (planning.handover), where
+            # the arm can reach with this grasp
+            places = [(None, X) for X in handover_object_poses(
+                handover, X_WO, X_WG, yaws_deg=config.place_yaws, lift=config.lift_height,
+                retreat=config.retreat_distance)]
+            if not places:
+                costs[i] = np.inf
+                reasons[i] = _farthest(reasons[i], "pre-place pose: the hand-over points are out "
+                                       "of the arm's reach with this grasp (its wrist outside "
+                                       "the shell joint 4 allows)")
+                continue
         if not places:
             # A tool rests only flat; any other object's turns were refused because its fingers
             # would carry it at the release: a place-and-regrasp may do (TURNED_IN_HAND).
@@ -938,24 +952,39 @@ def _waypoint_configurations(arms: _Arms, key: _KeyPoses, seeds, config):
         if not r.success:
             return poses, f"{name} pose unreachable ({r.reason})"
         poses[name] = r.q
-        start = ENTERED_FREE.get(name)
-        if start in poses and _jump(r.q, poses[start]) > BRANCH_JUMP:
-            # The straight move's end is on another IK branch than its start: solve the start
-            # again from the end's configuration, and let the free move before it make the turn.
-            make_start, start_distance = steps[start]
-            again = solve_ik_seeds(make_start(), key.X[start], [r.q],
+        chain = ENTERED_FREE.get(name, ())
+        if chain and chain[0] in poses and _jump(r.q, poses[chain[0]]) > BRANCH_JUMP:
+            # The straight move's end is on another IK branch than its start: solve the straight
+            # moves' poses before it again, back to the free move, each from the next one's
+            # configuration, and let the free move make the turn.
+            again, q_next = {}, r.q
+            for start in chain:
+                make_start, start_distance = steps[start]
+                s = solve_ik_seeds(make_start(), key.X[start], [q_next],
                                    position_tolerance=config.ik_position_tolerance,
                                    angle_tolerance=config.ik_angle_tolerance,
                                    min_distance=start_distance)
-            if again.success and _jump(r.q, again.q) < _jump(r.q, poses[start]):
-                poses[start] = again.q
+                if not s.success:
+                    break
+                again[start], q_next = s.q, s.q
+            if len(chain) == 1 and chain[0] in again:
+                if _jump(r.q, again[chain[0]]) < _jump(r.q, poses[chain[0]]):
+                    poses[chain[0]] = again[chain[0]]
+            elif len(again) == len(chain) and all(
+                    _jump(a, b) <= BRANCH_JUMP
+                    for a, b in zip([r.q, *again.values()], again.values(), strict=False)):
+                poses.update(again)  # the whole chain on the end's branch
         previous = r.q
     return poses, ""
 
 
-# The straight moves that a free move leads into (end → start): a branch change between their two
-# configurations is made up by solving the start again (`_waypoint_configurations`).
-ENTERED_FREE = {"grasp": "pre-grasp", "place": "pre-place"}
+# The straight moves that a free move leads into (end → the poses of the straight moves before
+# it, back to the free move's end): a branch change between an end and its start is made up by
+# solving those again from the end's configuration (`_waypoint_configurations`). The lift
+# follows the approach: a grasp with a wrist joint at its limit lifts on another branch (joint 5
+# turning ~2.9 rad during a 15 cm lift at the contact speed limits: a 9 s lift).
+ENTERED_FREE = {"grasp": ("pre-grasp",), "lift": ("grasp", "pre-grasp"),
+                "place": ("pre-place",)}
 BRANCH_JUMP = np.pi / 2  # [rad] a joint turning more than this between the two ends of a 10 cm
 # straight move is on another branch of the inverse kinematics (a wrist flip turns joints 5–7 by
 # about π); the straight move through it then takes many seconds at the contact speed limits.

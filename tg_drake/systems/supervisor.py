@@ -554,9 +554,14 @@ class Supervisor(LeafSystem):
             if not hand.held or rise < self._config.min_rise_ratio * gripper_rise:
                 if memory.retries < self._config.max_retries:
                     return self._retry(context, memory, plan, X_WO, "slipped")
+                # Say which test failed: the one rule of holding (outcome.is_held: both pads
+                # touch it, the fingers apart) or the rise it should have made with the gripper.
+                why = ("" if hand.held else
+                       f"not held at the lift's end (left pad {hand.left}, right pad "
+                       f"{hand.right}, fingers {hand.opening * 1000:.0f} mm apart); ")
                 return self._finish(memory, Status.grasped, Reason.slipped,
-                                    f"the object rose {rise * 100:.1f} cm while the gripper rose "
-                                    f"{gripper_rise * 100:.1f} cm")
+                                    f"{why}the object rose {rise * 100:.1f} cm while the gripper "
+                                    f"rose {gripper_rise * 100:.1f} cm")
             return dataclasses.replace(memory, checks_passed=2)
         if memory.checks_passed == 2 and pour:  # the pour's hold is over
             return dataclasses.replace(memory, checks_passed=3, held_at_pour=hand.held)
