@@ -667,7 +667,7 @@ def test_the_placed_object_is_its_part_shapes_moved_not_its_whole_box():
     np.testing.assert_allclose(moved[1][1].translation(), [0.60, -0.30, 0.08], atol=1e-12)
 
     arms = _Arms(None, PlannerConfig().open_width, [], target_shapes(obj),
-                 ("target_placed", RigidTransform(X_WO_place), tuple(obj.extents)), X_WO=X_WO)
+                 obj.extents, X_WO=X_WO)
     X_WG = grasp_pose([0.70, 0.15, 0.10], approach_W=[1, 0, 0], closing_W=[0, 1, 0])
     X_WG_place = X_WO_place @ np.linalg.inv(X_WO) @ X_WG
     for arm, X in ((arms.grasp, X_WG), (arms.placed(X_WO_place), X_WG_place)):

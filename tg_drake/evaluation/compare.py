@@ -19,9 +19,7 @@ from __future__ import annotations
 import re
 from collections import Counter, defaultdict
 
-import numpy as np
-
-from tg_drake.evaluation.tables import delivered
+from tg_drake.evaluation.tables import delivered, top_set
 from tg_drake.types import CATEGORIES
 
 MEASURES = ("category", "pose", "delivered", "e0")
@@ -38,9 +36,8 @@ def _category_ok(r) -> bool | None:
         if not isinstance(dist, dict) or not dist:
             return None
         p = [dist.get(c, 0.0) for c in CATEGORIES]
-    p = np.asarray(p, float)
-    best = np.flatnonzero(p >= p.max() - 1e-9)
-    return len(best) == 1 and CATEGORIES[best[0]] == (r.get("truth") or {}).get("category")
+    truth = (r.get("truth") or {}).get("category")
+    return truth in CATEGORIES and top_set(p) == {CATEGORIES.index(truth)}
 
 
 def _pose_ok(r) -> bool | None:

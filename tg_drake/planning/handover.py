@@ -39,6 +39,7 @@ Arrays in, arrays out: no Drake.
 
 
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -233,6 +234,7 @@ class Handover:
         return X
 
 
+@functools.cache
 def _arm_shell() -> tuple[np.ndarray, float, float, float]:
     """The iiwa's shoulder centre (3,) [m] in the world (its base at the origin, joint 1 along z),
     the shortest and longest distances [m] from it to the wrist centre (link 6's origin, where

@@ -308,9 +308,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
              for i, o in enumerate(obstacles)]
     boxes += [(f"surface_{s.name}", RigidTransform(np.asarray(s.X_WB)), tuple(s.size))
               for s in surfaces]
-    target_box = target_shapes(target)
-    placed_box = ("target_placed", RigidTransform(X_WO_place), tuple(target.extents))
-    arms = _Arms(scenario, config.open_width, boxes, target_box, placed_box, X_WO=X_WO)
+    arms = _Arms(scenario, config.open_width, boxes, target_shapes(target), target.extents,
+                 X_WO=X_WO)
     bearing = float(np.arctan2(X_WO[1, 3], X_WO[0, 3]))
     seeds = _seeds(q_start, config.seed_postures, bearing)
 
@@ -563,14 +562,15 @@ class _Arms:
     out of a placed object is judged as going into it was (the object's whole box there would put
     fingers that straddle a wall or a rim inside it).
 
-    `X_WO`: the target's pose now, where `target_shapes` stand."""
+    `extents`: the target's box [m] (held in the hand); `X_WO`: the target's pose now, where
+    `target_shapes` stand."""
 
-    def __init__(self, scenario, opening, boxes, target_shapes, placed_box, *, X_WO):
+    def __init__(self, scenario, opening, boxes, target_shapes, extents, *, X_WO):
         self._scenario, self._opening = scenario, opening
-        self._boxes, self._target, self._placed = list(boxes), list(target_shapes), placed_box
+        self._boxes, self._target = list(boxes), list(target_shapes)
         self._X_OW = RigidTransform(np.asarray(X_WO, float)).inverse()
         self._cache: dict = {}
-        self._held_size = tuple(placed_box[2])  # the object's box, carried in the hand
+        self._held_size = tuple(extents)  # the object's box [m], carried in the hand
 
     def _make(self, key, extra=(), held=None, finger_contact=()) -> ArmPlant:
         if key not in self._cache:

@@ -164,8 +164,8 @@ def second_leg_reachable(moved: ObjectDescription, parts, *, placing: TaskPlacin
              for i, o in enumerate(obstacles)]
     boxes += [(f"surface_{s.name}", RigidTransform(np.asarray(s.X_WB)), tuple(s.size))
               for s in surfaces]
-    arms = _Arms(scenario, config.open_width, boxes, target_shapes(moved),
-                 ("target_placed", RigidTransform(X_place0), tuple(moved.extents)), X_WO=X_WO)
+    arms = _Arms(scenario, config.open_width, boxes, target_shapes(moved), moved.extents,
+                 X_WO=X_WO)
     seeds = _seeds(q_start, config.seed_postures, float(np.arctan2(X_WO[1, 3], X_WO[0, 3])))
     centroid = np.asarray(moved.p_W, float).mean(axis=0) if len(moved.p_W) else None
     why = ""
@@ -316,8 +316,7 @@ def _back_to_start(plan, q_start, target: ObjectDescription, obstacles, surfaces
              for i, o in enumerate(obstacles)]
     boxes += [(f"surface_{s.name}", RigidTransform(np.asarray(s.X_WB)), tuple(s.size))
               for s in surfaces]
-    placed_box = ("target_placed", RigidTransform(plan.X_WO_place), tuple(target.extents))
-    arms = _Arms(scenario, config.open_width, boxes, target_shapes(target), placed_box,
+    arms = _Arms(scenario, config.open_width, boxes, target_shapes(target), target.extents,
                  X_WO=target.X_WO)
     q_end = plan.q(plan.duration)
     seeds = _seeds(q_start, config.seed_postures, 0.0)
