@@ -316,9 +316,10 @@ class SupervisorConfig:
 
 
 def _pipeline_logic() -> LogicQueryConfig:
-    # The logic sees (1 − floor)·prior + floor/11: a perceived object's kernel prior can miss its
-    # category, and a zero there would make the evidence impossible.
-    return LogicQueryConfig(prior_floor=0.02)
+    # The logic sees (1 − floor)·prior + floor/11 with the floor the kernel database fitted for
+    # its kind of query (None): a perceived object's kernel prior can miss its category, and a
+    # zero there would make the evidence impossible.
+    return LogicQueryConfig(prior_floor=None)
 
 
 @dataclass
@@ -356,7 +357,7 @@ class PipelineConfig:
             self.logic.theory()
         except RuleError as e:
             raise ScenarioError(e.message, field=f"{where}.logic.{e.field}") from None
-        if not 0.0 <= self.logic.prior_floor <= 1.0:
+        if self.logic.prior_floor is not None and not 0.0 <= self.logic.prior_floor <= 1.0:
             raise ScenarioError(f"prior_floor must be in [0, 1], got {self.logic.prior_floor}",
                                 field=f"{where}.logic.prior_floor")
         if self.prior.clouds is not None and self.prior.clouds not in KERNEL_SOURCES:

@@ -52,6 +52,15 @@ POSES: tuple[str, ...] = ("upright", "sideways", "upsidedown")
 CONTAINMENTS: tuple[str, ...] = ("empty", "full")
 
 
+SCANLIKE_SUFFIX = "_scan"  # the id of an object's scan-like version (tools/make_scanlike.py)
+
+
+def source_objects(ids) -> np.ndarray:
+    """(N,) str: each object id with its scan-like suffix dropped, the object it was made from
+    (a scan-like version and its original are one object for leave-one-object-out)."""
+    return np.array([str(i).removesuffix(SCANLIKE_SUFFIX) for i in np.atleast_1d(ids)], dtype=str)
+
+
 def part_index(name: str) -> int:
     """The integer label of a part name; ValueError listing the names if unknown."""
     try:
@@ -98,6 +107,9 @@ class ObjectDescription:
     is_tool: bool = False  # True when perception classified the shape as a tool.
     name: str = ""  # ground-truth instance name when known (GroundTruthPerception), else "".
     interior_seen: float = 0.0  # probability that its inside was seen through a wide opening.
+    interior_hidden: float = 0.0  # probability that perception looked for its inside and did not
+    # see it (1 − interior_seen from perception; 0 when nothing looked, e.g. a hand-made
+    # description).
     pose_cue: str = ""  # what decided the pose (perception.pose.PoseEstimate.cue), or "".
     pose_end: tuple | None = None  # the closed end on top, (recess, dome, rise, rise error)
     # [m] and its wall's (narrowing, error) [m/m] (NaN: no wall), when the pose reached that cue
@@ -137,6 +149,8 @@ class CategoryDistribution:
     probabilities: np.ndarray  # (11,) in CATEGORIES order, sums to 1.
     neighbours: list[tuple[str, str, float]] = field(default_factory=list)
     # (database object id, its category, normalised kernel value), most similar first.
+    floor: float = 0.0  # the database's fitted floor ε for this kind of query
+    # (KernelDatabase.floor): the logic sees (1 − ε)·probabilities + ε/11, unless told otherwise.
 
     def as_dict(self) -> dict[str, float]:
         return {c: float(p) for c, p in zip(CATEGORIES, self.probabilities, strict=True) if p > 0}

@@ -1,6 +1,10 @@
 """Builds the kernel-prior database shipped with the package (tg_drake/data/kernel_db.npz).
 
-    nice -n 10 python tools/build_kernel_db.py --workers 2   # the shipped file
+    nice -n 10 python tools/build_kernel_db.py --workers 2   # generated objects only
+    python tools/build_kernel_db.py --scanlike --workers 2  # the shipped file: with the
+    #   training objects' scan-like versions (tools/make_scanlike.py --all --import [--library
+    #   models/objects_b] first; a scan-like version and its original are one object for
+    #   leave-one-object-out)
     python tools/build_kernel_db.py --check         # rebuild and compare with the shipped file
     python tools/build_kernel_db.py --samplings 5 --out /tmp/kernel_db.npz
     python tools/build_kernel_db.py --objects all-a --sensor ideal  # the database before the split
@@ -24,7 +28,10 @@ Then the LSH projections are drawn, every graph is hashed for t = 0..15, and the
 the T and the entries a perceived query is compared with ("all", "perceived" or "ground_truth")
 are chosen by leave-one-object-out cross-validation: every perceived view is a query against the
 graphs of all other objects, the choice with the best accuracy (then mean rank, then the larger
-w, the smaller T) wins. The paper's w = 1e-4 is one of the candidates; the coarser bins that
+w, the smaller T) wins. At that choice, the same leave-one-object-out priors give the prior's
+floor ε for each kind of query (the maximum-likelihood ε of (1 − ε)·prior + ε/11 for the true
+category): the logic sees the prior calibrated so (`KernelDatabase.floor`). The paper's
+w = 1e-4 is one of the candidates; the coarser bins that
 perceived clouds favour also keep the file small. The file holds the hashed counts, the
 projections, where each graph came from and the choice. Everything
 follows from `--seed` (perception, ray casting and the seeded sensor model are deterministic, in
@@ -53,9 +60,10 @@ from tg_drake.kernels.library import (
     library_fingerprint,
     perceived_views,
 )
+from tg_drake.kernels.prior import category_priors, fit_prior_floor
 from tg_drake.kernels.propagation import BIN_WIDTH, T_MAX, LshProjections
 from tg_drake.perception.sensor_model import IdealDepth, StructuredLight
-from tg_drake.types import CATEGORIES
+from tg_drake.types import CATEGORIES, SCANLIKE_SUFFIX, source_objects
 
 OUT = Path(__file__).resolve().parents[1] / "tg_drake" / "data" / "kernel_db.npz"
 BIN_WIDTHS = (BIN_WIDTH, 1e-3, 1e-2, 3e-2, 1e-1)  # LSH bin widths w cross-validated.
@@ -63,16 +71,31 @@ BIN_WIDTHS = (BIN_WIDTH, 1e-3, 1e-2, 3e-2, 1e-1)  # LSH bin widths w cross-valid
 SENSORS = {"d415": StructuredLight(), "ideal": IdealDepth()}
 
 
-def object_ids(which: str) -> list[str]:
-    """The database's objects: the split's training objects (sets a and b) or all of set a."""
+def object_ids(which: str, scanlike: bool = False) -> list[str]:
+    """The database's objects: the split's training objects (sets a and b) or all of set a;
+    `scanlike`: with the scan-like version (<id>_scan) of each, from the scan-like libraries
+    `tools/make_scanlike.py --all --import [--library L]` writes (registered here)."""
     from tg_drake.evaluation.split import load_split  # a tool: may read the evaluation's split
-    from tg_drake.objects import load_library
+    from tg_drake.objects import add_library, load_library
+    from tg_drake.scanlike import scanlike_library
 
     if which == "all-a":
-        return list(load_library())
-    split = load_split()
-    split.register_libraries()
-    return list(split.train)
+        ids, libraries = list(load_library()), [None]
+    else:
+        split = load_split()
+        split.register_libraries()
+        ids = list(split.train)
+        libraries = [None if s.shipped else s.library for s in split.sets.values()]
+    if not scanlike:
+        return ids
+    for library in libraries:
+        folder = scanlike_library(library)
+        if not (folder / "library.yaml").is_file():
+            raise SystemExit(f"no scan-like library at {folder}: make it first with "
+                             "python tools/make_scanlike.py --all --import"
+                             + ("" if library is None else f" --library {library}"))
+        add_library(folder)
+    return ids + [f"{i}{SCANLIKE_SUFFIX}" for i in ids]
 
 
 def _progress(done: int, total: int) -> None:
@@ -88,7 +111,8 @@ def cross_validate(db: KernelDatabase, clouds: str = "perceived") -> tuple[dict,
     if queries.size == 0:
         raise KernelError(f"no {clouds} graphs to cross-validate on")
     rows = db.member_profile(queries)
-    not_own = db.object_ids[queries][:, None] != db.object_ids[None, :]
+    ids = source_objects(db.object_ids)  # a scan-like version is its original's object
+    not_own = ids[queries][:, None] != ids[None, :]
     scores = {}
     for entries in ENTRIES:
         allowed = not_own & db.entry_mask(entries)[None, :]
@@ -101,6 +125,18 @@ def cross_validate(db: KernelDatabase, clouds: str = "perceived") -> tuple[dict,
     return ({"entries": entries, "T": t, "accuracy": scores[entries, t][0],
              "mean_rank": scores[entries, t][1]},
             {f"{e}/{t}": v for (e, t), v in scores.items()})
+
+
+def fitted_floor(db: KernelDatabase, clouds: str, entries: str, t: int) -> float:
+    """The prior's floor ε for queries of one source (`clouds`) at the chosen entries and T: the
+    maximum-likelihood ε of (1 − ε)·prior + ε/11 over the leave-one-object-out priors of the
+    database's own graphs of that source (`tg_drake.kernels.prior.fit_prior_floor`)."""
+    queries = np.flatnonzero(db.sources == clouds)
+    ids = source_objects(db.object_ids)
+    allowed = (ids[queries][:, None] != ids[None, :]) & db.entry_mask(entries)[None, :]
+    priors, _ = category_priors(np.where(allowed, db.member_profile(queries)[t], -np.inf),
+                                db.categories)
+    return fit_prior_floor(priors, db.categories[queries])
 
 
 def build(*, samplings: int, spacing: float, seed: int, viewpoints=VIEWPOINTS,
@@ -154,7 +190,11 @@ def build(*, samplings: int, spacing: float, seed: int, viewpoints=VIEWPOINTS,
     # own choice of entries and T at the chosen w.
     chosen_gt, _ = cross_validate(db, "ground_truth")
     db.t_ground_truth, db.entries_ground_truth = chosen_gt["T"], chosen_gt["entries"]
-    db.library_fingerprint = library_fingerprint(sorted(set(ids)))
+    db.floor_default = fitted_floor(db, "perceived", db.entries_default, db.t_default)
+    db.floor_ground_truth = fitted_floor(db, "ground_truth", db.entries_ground_truth,
+                                         db.t_ground_truth)
+    # Of the generated objects: a scan-like version follows from its original and the seed.
+    db.library_fingerprint = library_fingerprint(sorted(set(source_objects(ids).tolist())))
     sizes = np.array([len(c.labels) for c in clouds])
     return db, {"n_objects": len(set(ids)), "n_graphs": len(clouds), "n_ground_truth": n_gt,
                 "n_perceived": n_views, "perception_failures": failures,
@@ -173,6 +213,9 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=OUT, help="output .npz")
     parser.add_argument("--objects", choices=("train", "all-a"), default="train",
                         help="the split's training objects (default) or all of set a")
+    parser.add_argument("--scanlike", action="store_true",
+                        help="add the scan-like version of each object (tools/make_scanlike.py "
+                             "--all --import, for each set's library, first)")
     parser.add_argument("--sensor", choices=tuple(SENSORS), default="d415",
                         help="depth sensor model of the perceived views (default %(default)s)")
     parser.add_argument("--workers", type=int, default=1, help="processes perceiving views")
@@ -185,12 +228,12 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
 
     t0 = time.perf_counter()
-    ids = object_ids(args.objects)
+    ids = object_ids(args.objects, args.scanlike)
     pool = None
     if args.workers > 1:
         import multiprocessing
         pool = multiprocessing.get_context("spawn").Pool(
-            args.workers, object_ids, (args.objects,))  # registers the split's libraries
+            args.workers, object_ids, (args.objects, args.scanlike))  # registers the libraries
     try:
         db, summary = build(samplings=args.samplings, spacing=args.spacing, seed=args.seed,
                             object_ids=ids, viewpoints=VIEWPOINTS[:args.viewpoints],
@@ -211,6 +254,8 @@ def main(argv=None) -> int:
     print(f"cross-validated for perceived queries: w = {c['w']:g}, entries {c['entries']}, "
           f"T = {c['T']}: "
           f"leave-one-object-out accuracy {c['accuracy']:.3f}, mean rank {c['mean_rank']:.2f}")
+    print(f"fitted prior floors (maximum likelihood, leave-one-object-out): perceived "
+          f"{db.floor_default:.3f}, ground truth {db.floor_ground_truth:.3f}")
     g = summary["chosen_ground_truth"]
     print(f"cross-validated for ground-truth samplings as queries: entries {g['entries']}, "
           f"T = {g['T']}: accuracy {g['accuracy']:.3f}, mean rank {g['mean_rank']:.2f}")
@@ -235,7 +280,8 @@ def main(argv=None) -> int:
 def _same(a: KernelDatabase, b: KernelDatabase) -> bool:
     """Equal contents (the .npz bytes hold zip timestamps, so compare the arrays)."""
     fa, fb = a.features, b.features
-    return (np.array_equal(a.object_ids, b.object_ids)
+    return (a.floor_default == b.floor_default and a.floor_ground_truth == b.floor_ground_truth
+            and np.array_equal(a.object_ids, b.object_ids)
             and np.array_equal(a.categories, b.categories)
             and np.array_equal(a.sources, b.sources) and np.array_equal(a.poses, b.poses)
             and np.array_equal(a.yaws, b.yaws, equal_nan=True)

@@ -38,15 +38,12 @@ import numpy as np
 from tg_drake.errors import TgDrakeError
 from tg_drake.evaluation.split import SCANLIKE_SUFFIX
 from tg_drake.objects import add_library, load_library, mesh
-from tg_drake.scanlike import FORMATS, ScanLikeConfig, write_scanlike
+from tg_drake.scanlike import FORMATS, ScanLikeConfig, scanlike_library, write_scanlike
 
 
 def default_out(library: Path | None) -> Path:
     """Where --import writes by default: the cache's scanlike/<library folder name>."""
-    from tg_drake.importing.library import default_cache_root
-
-    name = "objects" if library is None else Path(library).resolve().name
-    return default_cache_root().parent / "scanlike" / name
+    return scanlike_library(library)
 
 
 def import_scanlike(obj, path: Path, out: Path):

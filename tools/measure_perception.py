@@ -13,6 +13,7 @@ reads them too.
     nice -n 10 .venv/bin/python tools/measure_perception.py --stride 4 --out /tmp/p4.jsonl
     .venv/bin/python tools/measure_perception.py --summary /tmp/p/results.jsonl
     .venv/bin/python tools/measure_perception.py --compare /tmp/run1.jsonl /tmp/run2.jsonl
+    .venv/bin/python tools/measure_perception.py --fit /tmp/p/results.jsonl  # fitted inputs
     ... --database /tmp/kernel_db.npz  # another kernel database than the shipped one
     ... --pose-calibration /tmp/pose.json  # another pose likelihood (tools/calibrate_pose.py)
 
@@ -139,9 +140,23 @@ def main(argv=None) -> int:
     p.add_argument("--pose-calibration", help="pose likelihood .json (default: the shipped one)")
     p.add_argument("--out", type=Path, help="write the records here (JSON lines)")
     p.add_argument("--summary", type=Path, help="only summarise these records")
+    p.add_argument("--fit", type=Path, metavar="RECORDS",
+                   help="fit the logic's inputs on these records' training side: the kernel "
+                        "prior's floor and the dish-interior miss rate")
     p.add_argument("--compare", type=Path, nargs=2, metavar=("A", "B"),
                    help="list the cases whose records differ between two records files")
     args = p.parse_args(argv)
+    if args.fit:
+        from tg_drake.evaluation.calibration import dish_interior_miss, prior_floor_of
+        from tg_drake.evaluation.split import load_split
+
+        split = load_split()
+        train = [r for r in _read(args.fit) if split.role(r["object"]) == "train"]
+        eps, n = prior_floor_of(train)
+        miss, k, m = dish_interior_miss(train)
+        print(f"kernel prior floor (max. likelihood, {n} training views): {eps:.3f}")
+        print(f"P(inside unseen | dish upright): {miss:.4f} ({k} of {m} training views, Laplace)")
+        return 0
     if args.compare:
         diff, n = compare(_read(args.compare[0]), _read(args.compare[1]))
         print(f"{len(diff)} of the {n} records both hold differ"

@@ -6,7 +6,16 @@ import numpy as np
 import pytest
 
 from tg_drake.errors import RuleError
-from tg_drake.logic.observations import SCHEMA_PARAMETERS, Observations, count_handles
+from tg_drake.logic.engine import LogicEngine
+from tg_drake.logic.observations import (
+    HANDLE_PAIR_PRIOR,
+    SCHEMA_PARAMETERS,
+    Observations,
+    count_handles,
+    handle_pair_probability,
+    opposite_unseen,
+    pair_probability_of,
+)
 from tg_drake.logic.theory import TheoryConfig, load_theory, rules_dir
 from tg_drake.types import CATEGORIES, CategoryDistribution, ObjectDescription, part_index
 
@@ -30,6 +39,7 @@ CUP = {"parts": {"top": 0.8, "middle": 1.0, "bottom": 1.0, "handle": 1.0},
     ({"collisions": ["rim"]}, "field 'collisions'.*unknown part 'rim'"),
     ({"handles": 3}, "handles must be 1 or 2"),
     ({"interior_seen": 2}, "field 'interior_seen'.*probability in \\[0, 1\\], got 2"),
+    ({"handle_pair": 1.5}, "field 'handle_pair'.*probability in \\[0, 1\\], got 1.5"),
     ({"colour": "red"}, "unknown field 'colour'; allowed: parts, pose"),
     ({"parts": None}, "field 'parts'"),
 ])
@@ -87,6 +97,69 @@ def test_count_handles_from_the_handle_points():
     assert count_handles(_object([m] * 100 + [h] * 50, np.concatenate([body, one]))) == 1
     assert count_handles(_object([m] * 100 + [h] * 100, np.concatenate([body, two]))) == 2
     assert count_handles(_object([m] * 100, body)) == 1
+
+
+def _mug(rng, seen_opposite: float):
+    """A cylinder of radius 4 cm (z its axis) with a handle on +x; `seen_opposite` of the wall
+    within 45° of −x is observed, the rest of the points completed."""
+    h, m = part_index("handle"), part_index("middle")
+    theta = rng.uniform(-np.pi, np.pi, 2000)
+    wall = np.column_stack([0.04 * np.cos(theta), 0.04 * np.sin(theta),
+                            rng.uniform(-0.05, 0.05, 2000)])
+    handle = np.column_stack([0.06 + rng.normal(0, 0.003, 100), rng.normal(0, 0.005, 100),
+                              rng.uniform(-0.03, 0.03, 100)])
+    opposite = (np.cos(theta) <= -np.cos(np.pi / 4)) & (np.abs(wall[:, 2]) <= 0.03)
+    visible = ~opposite | (rng.uniform(size=2000) < seen_opposite)
+    labels = np.array([m] * 2000 + [h] * 100)
+    return (np.concatenate([wall, handle]), labels,
+            np.concatenate([visible, np.ones(100, bool)]))
+
+
+@pytest.mark.parametrize("seen", [0.0, 0.5, 1.0])
+def test_opposite_unseen_is_the_completed_share_of_the_side_away_from_the_handle(seen):
+    p, labels, visible = _mug(np.random.default_rng(1), seen)
+    assert opposite_unseen(p, labels, visible) == pytest.approx(1.0 - seen, abs=0.06)
+    # Nothing of the body at the handle's height: nothing seen there at all.
+    low = p[:, 2] < -0.035
+    keep = low | (labels == part_index("handle"))
+    assert opposite_unseen(p[keep], labels[keep], visible[keep]) == 1.0
+    # No handle points: no second handle to miss.
+    body = labels != part_index("handle")
+    assert opposite_unseen(p[body], labels[body], visible[body]) == 0.0
+
+
+def test_handle_pair_probability_weighs_what_the_view_could_miss():
+    assert handle_pair_probability(2, 0.0) == 1.0
+    assert handle_pair_probability(1, 0.0) == 0.0
+    assert handle_pair_probability(1, 1.0) == pytest.approx(HANDLE_PAIR_PRIOR)
+    p = [handle_pair_probability(1, u) for u in np.linspace(0, 1, 11)]
+    assert np.all(np.diff(p) > 0)
+    rng = np.random.default_rng(2)
+    pts, labels, visible = _mug(rng, 0.0)
+    obj = _object(labels, pts)
+    obj.visible = visible
+    assert pair_probability_of(obj) == pytest.approx(HANDLE_PAIR_PRIOR, abs=0.01)
+    obj.visible = np.ones(len(pts), bool)
+    assert pair_probability_of(obj) == 0.0
+
+
+def test_the_pair_probability_moves_pot_against_cup_and_pan():
+    engine = LogicEngine(TheoryConfig())
+    prior = {"pot": 0.5, "cup": 0.3, "pan": 0.2}
+
+    def p_pot(pair):
+        obs = Observations(parts={"top": 1, "middle": 1, "bottom": 1, "handle": 1},
+                           pose={"upright": 1.0}, category_prior=prior, handle_pair=pair)
+        return engine.query(obs).category[CATEGORIES.index("pot")]
+
+    # One handle for sure rules a pot out; a pair seen makes it one; in between, the more of
+    # the far side the view missed, the more likely a pot.
+    assert p_pot(0.0) == 0.0 and p_pot(1.0) == pytest.approx(1.0)
+    p = [p_pot(x) for x in (0.05, 0.15, 0.25, 1 / 3)]
+    assert 0.0 < p[0] and np.all(np.diff(p) > 0) and p[-1] < 1.0
+    # handle_pair not given: two handles seen count as a pair, one as no pair.
+    assert Observations(parts={"handle": 1}, handles=2).pair_probability == 1.0
+    assert Observations(parts={"handle": 1}, handles=1).pair_probability == 0.0
 
 
 def test_from_object_uses_perception_the_prior_and_the_task():

@@ -28,7 +28,12 @@ from tg_drake.evaluation.suite import DATASET_OF_SETTING
 from tg_drake.kernels.database import load_database
 from tg_drake.kernels.library import sample_object
 from tg_drake.logic.engine import LogicEngine
-from tg_drake.logic.observations import Observations, count_handles, handle_count
+from tg_drake.logic.observations import (
+    Observations,
+    count_handles,
+    handle_count,
+    pair_probability_of,
+)
 from tg_drake.logic.theory import TheoryConfig
 from tg_drake.objects import get_object, mesh
 from tg_drake.perception.ground_truth import interior_visible
@@ -64,8 +69,6 @@ METHODS = {
     "plm_paper_observations": (("specific", "specific", True), ("specific", "specific", True),
                                "manifolds", "no_interior"),
 }
-PRIOR_FLOOR = 0.02  # the pipeline's (PipelineConfig.prior_floor): a prior that misses the true
-# category cannot make perceived evidence impossible.
 CONFIDENT_PART = 0.5  # S_REAL: detected parts at least this likely are kept (as certain).
 # The depth sensor the perceived and executed suites see: a realistic camera's measurement of the
 # render (tg_drake.perception.sensor_model; a scenario's own default is the exact render).
@@ -81,36 +84,42 @@ def _round(v) -> list[float]:
     return [round(float(x), 6) for x in v]
 
 
-def _prior(kind: str, priors: dict) -> dict | None:
+def _prior(kind: str, priors: dict, floor: float) -> dict | None:
     if kind == "uniform":
         return None
     p = np.asarray(priors["manifolds"], dtype=float)
     if kind == "top":
         p = np.eye(len(CATEGORIES))[int(np.argmax(p))]
-    p = (1.0 - PRIOR_FLOOR) * p + PRIOR_FLOOR / len(CATEGORIES)
+    p = (1.0 - floor) * p + floor / len(CATEGORIES)
     return dict(zip(CATEGORIES, p.tolist(), strict=True))
 
 
 def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS,
-                  theory: str = "specific") -> dict:
+                  theory: str = "specific", clouds: str = "perceived") -> dict:
     """Every method's category and task distributions (task inferred) and, for each task of the
     ground truth, its part distribution. `theory` stands in for the specific model variant (e.g.
-    "learned"). An impossible observation (probability 0) is recorded as the error it is, with no
-    distributions."""
+    "learned"); `clouds` is the kind of query the priors answered ("perceived" or
+    "ground_truth"), whose fitted floor the kernel database gives (`KernelDatabase.floor`), as
+    the pipeline's logic uses it. An impossible observation (probability 0) is recorded as the
+    error it is, with no distributions."""
+    floor = load_database().floor(clouds)
+
     def variant(models):
         return tuple(theory if m == "specific" else m for m in models[:2]) + models[2:]
 
     out = {}
     for name, (cat_theory, grasp_theory, prior_kind, *flags) in methods.items():
         cat_theory, grasp_theory = variant(cat_theory), variant(grasp_theory)
-        prior = _prior(prior_kind, priors)
+        prior = _prior(prior_kind, priors, floor)
         interior = 0.0 if "no_interior" in flags else observations.interior_seen
+        hidden = 0.0 if "no_interior" in flags else observations.interior_hidden
 
-        def obs(task=None, prior=prior, interior=interior):
+        def obs(task=None, prior=prior, interior=interior, hidden=hidden):
             return Observations(parts=observations.parts, pose=observations.pose,
                                 containment=observations.containment, category_prior=prior,
                                 task=task, handles=observations.handles,
-                                interior_seen=interior)
+                                handle_pair=observations.handle_pair,
+                                interior_seen=interior, interior_hidden=hidden)
 
         try:
             answer = _engine(*cat_theory).query(obs())
@@ -146,13 +155,14 @@ def run_synthetic(case) -> dict:
     # one point cloud per object, so its Manifolds accuracy is over objects: 36 of 41 = 87.8 %).
     cloud = sample_object(obj, spacing=load_database().spacing,
                           rng=np.random.default_rng(_seed(obj.id, case.seed)))
+    seen = interior_visible(obj.id, placement.pose)
     observations = Observations(parts={p: 1.0 for p in obj.parts}, pose={placement.pose: 1.0},
                                 containment={placement.containment: 1.0}, handles=handles,
-                                interior_seen=interior_visible(obj.id, placement.pose))
+                                interior_seen=seen, interior_hidden=1.0 - seen)
     priors = kernel_priors(cloud.points, cloud.normals, cloud.labels, object_id=obj.id,
                            t=case.kernel_T, clouds="ground_truth")
     return {**case.meta(), "priors": priors,
-            "methods": logic_answers(observations, priors, case.truth.tasks,
+            "methods": logic_answers(observations, priors, case.truth.tasks, clouds="ground_truth",
                                        theory=case.theory)}
 
 
@@ -168,7 +178,9 @@ def setting_observations(description, setting: str, *, true_pose: str, containme
         parts, pose = detected, dict(description.pose_likelihood)
     return Observations(parts=parts, pose=pose, containment={containment: 1.0},
                         handles=count_handles(description),
-                        interior_seen=description.interior_seen)
+                        handle_pair=pair_probability_of(description),
+                        interior_seen=description.interior_seen,
+                        interior_hidden=description.interior_hidden)
 
 
 def run_perceived(case) -> list[dict]:
@@ -194,6 +206,11 @@ def run_perceived(case) -> list[dict]:
             obs = setting_observations(d, setting, true_pose=placement.pose,
                                        containment=placement.containment)
             record["observed_parts"] = sorted(obs.parts)
+            record["observations"] = {"parts": obs.parts, "pose": obs.pose,
+                                      "handles": obs.handles,
+                                      "handle_pair": round(obs.pair_probability, 6),
+                                      "interior_seen": round(obs.interior_seen, 6),
+                                      "interior_hidden": round(obs.interior_hidden, 6)}
             record["methods"] = logic_answers(obs, priors, case.truth.tasks,
                                                   theory=case.theory)
         records.append(record)

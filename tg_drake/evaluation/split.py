@@ -37,10 +37,10 @@ import yaml
 
 from tg_drake.errors import ScenarioError, TgDrakeError, unknown_name
 from tg_drake.objects import PACKAGE, add_library, load_library, shipped_root
+from tg_drake.types import SCANLIKE_SUFFIX  # noqa: F401 (the split's ids; re-exported)
 
 SPLIT_PATH = Path(__file__).resolve().parents[2] / "scenarios" / "suites" / "split.yaml"
 ROLES = ("train", "held_out")
-SCANLIKE_SUFFIX = "_scan"  # the id of an object's scan-like version: <id>_scan
 
 
 @dataclass(frozen=True)

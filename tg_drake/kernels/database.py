@@ -34,7 +34,7 @@ from tg_drake.kernels.propagation import (
     graph_features,
     propagation_hashes,
 )
-from tg_drake.types import CATEGORIES, PART_LABELS, CategoryDistribution
+from tg_drake.types import CATEGORIES, PART_LABELS, CategoryDistribution, source_objects
 
 FORMAT_VERSION = 3  # 3: clouds scaled to unit size before resampling (spacing relative).
 SOURCES = ("ground_truth", "perceived")  # where a database graph came from.
@@ -93,6 +93,10 @@ class KernelDatabase:
     entries_default: str = "all"  # ENTRIES a query compares with when it names none.
     t_ground_truth: int = 0  # T and entries chosen for ground-truth samplings as queries
     entries_ground_truth: str = "all"  # (the defaults above serve perceived clouds).
+    floor_default: float = 0.0  # the prior's floor ε for perceived queries and for ground-truth
+    floor_ground_truth: float = 0.0  # samplings: (1 − ε)·prior + ε/11 is the calibrated prior,
+    # ε fitted at build time by maximum likelihood of the true category over the database's own
+    # graphs as leave-one-object-out queries (tools/build_kernel_db.py). 0: not fitted.
 
     def __post_init__(self):
         g = self.object_ids.shape[0]
@@ -147,6 +151,12 @@ class KernelDatabase:
             raise unknown_name("kind of query clouds", clouds, SOURCES, error=KernelError)
         return ((self.entries_default, self.t_default) if clouds == "perceived"
                 else (self.entries_ground_truth, self.t_ground_truth))
+
+    def floor(self, clouds: str) -> float:
+        """The prior's fitted floor ε for queries of this kind (`SOURCES`): the logic sees
+        (1 − ε)·prior + ε/11 (`Observations.from_object`)."""
+        self.choice(clouds)  # checks the kind
+        return self.floor_default if clouds == "perceived" else self.floor_ground_truth
 
     def resolve_entries(self, entries: str | None) -> str:
         entries = self.entries_default if entries is None else entries
@@ -204,14 +214,15 @@ class KernelDatabase:
         """The category prior of one cloud: the n most similar graphs weighted by exp(−rank).
 
         `entries` picks the graphs compared with ("all", "ground_truth", "perceived"; None: the
-        database's default). `exclude_object` leaves every graph of that object out
-        (leave-one-object-out); an object the database does not hold (one imported after it was
-        built) leaves nothing out.
+        database's default). `exclude_object` leaves every graph of that object (and of its
+        scan-like version or original) out (leave-one-object-out); an object the database does
+        not hold (one imported after it was built) leaves nothing out.
         """
         mask = self.entry_mask(entries)
         sim = np.where(mask, self.similarities(points, normals, labels, t=t), -np.inf)
-        if exclude_object is not None:
-            sim = np.where(self.object_ids == exclude_object, -np.inf, sim)
+        if exclude_object is not None:  # the object and its scan-like version or original
+            own = source_objects(self.object_ids) == source_objects(exclude_object)[0]
+            sim = np.where(own, -np.inf, sim)
         priors, neighbours = category_priors(sim, self.categories, n_neighbours=n_neighbours)
         return CategoryDistribution(
             probabilities=priors[0],
@@ -240,6 +251,8 @@ class KernelDatabase:
             entries_default=np.array(self.entries_default),
             t_ground_truth=np.array(self.t_ground_truth),
             entries_ground_truth=np.array(self.entries_ground_truth),
+            floor_default=np.array(self.floor_default),
+            floor_ground_truth=np.array(self.floor_ground_truth),
             vocab_sizes=np.array([len(v) for v in f.vocabularies], dtype=np.int64),
             vocab=np.concatenate(f.vocabularies),
             # Per bin (column): how many graphs have it; then those graphs and their counts.
@@ -295,7 +308,11 @@ class KernelDatabase:
                 viewpoints=data["viewpoints"].astype(np.int64),
                 entries_default=str(data["entries_default"]),
                 t_ground_truth=int(data["t_ground_truth"]),
-                entries_ground_truth=str(data["entries_ground_truth"]))
+                entries_ground_truth=str(data["entries_ground_truth"]),
+                floor_default=float(data["floor_default"]) if "floor_default" in data
+                else 0.0,
+                floor_ground_truth=float(data["floor_ground_truth"])
+                if "floor_ground_truth" in data else 0.0)
 
 
 @functools.lru_cache(maxsize=4)

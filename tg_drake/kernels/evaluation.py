@@ -14,7 +14,7 @@ import numpy as np
 from tg_drake.kernels.database import ENTRIES
 from tg_drake.kernels.library import VIEW_YAWS_DEG
 from tg_drake.kernels.prior import N_NEIGHBOURS, category_priors, is_correct, true_category_rank
-from tg_drake.types import CATEGORIES
+from tg_drake.types import CATEGORIES, source_objects
 
 
 @dataclass
@@ -40,7 +40,7 @@ def score_priors(priors: np.ndarray, truth: np.ndarray, T: int | None) -> Score:
 def leave_one_object_out(k_hat: np.ndarray, object_ids, categories, *,
                          n_neighbours: int = N_NEIGHBOURS) -> list[Score]:
     """Scores for every T of a stack of normalised database kernels K̂ (T + 1, G, G)."""
-    ids = np.asarray(object_ids)
+    ids = source_objects(object_ids)  # a scan-like version is its original's object
     cats = np.asarray(categories)
     same_object = ids[:, None] == ids[None, :]
     scores = []
@@ -58,7 +58,7 @@ def query_scores(k_hat_rows: np.ndarray, query_ids, query_categories, db_ids, db
     k_hat_rows: (T + 1, Q, G) normalised kernel rows; database graphs of the query's own object
     are left out.
     """
-    same_object = np.asarray(query_ids)[:, None] == np.asarray(db_ids)[None, :]
+    same_object = source_objects(query_ids)[:, None] == source_objects(db_ids)[None, :]
     scores = []
     for t, k in enumerate(k_hat_rows):
         priors, _ = category_priors(np.where(same_object, -np.inf, k), db_categories,
@@ -107,7 +107,7 @@ def nested_leave_one_object_out(k_hat_rows: np.ndarray, query_ids, query_categor
     queries of the other objects against a database without o and without the query's own
     object; o's graphs are never in the database of o's queries, nor of the inner choice.
     """
-    q_ids, db_ids = np.asarray(query_ids), np.asarray(db_ids)
+    q_ids, db_ids = source_objects(query_ids), source_objects(db_ids)
     q_cats = np.asarray(query_categories)
     t_values = list(range(k_hat_rows.shape[0])) if t_values is None else list(t_values)
     own = q_ids[:, None] == db_ids[None, :]

@@ -8,6 +8,7 @@ distribution over the 11 categories.
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from tg_drake.errors import KernelError
 from tg_drake.types import CATEGORIES
@@ -63,3 +64,19 @@ def is_correct(priors: np.ndarray, truth: np.ndarray) -> np.ndarray:
     p = np.atleast_2d(priors)
     best = p.max(axis=1, keepdims=True)
     return (p[np.arange(p.shape[0]), truth] == best[:, 0]) & (np.sum(p == best, axis=1) == 1)
+
+
+def fit_prior_floor(priors: np.ndarray, truth: np.ndarray) -> float:
+    """ε in [0, 1] maximising Σ log((1 − ε)·p[i, truth[i]] + ε/K) over the rows of `priors`
+    (N, K), each a kernel prior, `truth` (N,) the true category's index."""
+    priors = np.asarray(priors, dtype=float)
+    if priors.ndim != 2 or len(priors) == 0 or len(truth) != len(priors):
+        raise ValueError("priors must be (N, K) with N ≥ 1 and one truth index per row")
+    p_true = priors[np.arange(len(priors)), np.asarray(truth, dtype=int)]
+    k = priors.shape[1]
+
+    def nll(eps):
+        return -np.mean(np.log((1.0 - eps) * p_true + eps / k))
+
+    return float(minimize_scalar(nll, bounds=(0.0, 1.0), method="bounded",
+                                 options={"xatol": 1e-4}).x)

@@ -149,7 +149,8 @@ def _inconsistent(obs: Observations, config: TheoryConfig) -> RuleError:
     return RuleError(
         "the observations have probability 0 under the theory "
         f"({config.category} category model): no category of the prior ({prior}) is "
-        f"compatible with the observed parts ({parts}, handles {obs.handles}"
+        f"compatible with the observed parts ({parts}, handles {obs.handles}, "
+        f"P(pair) {obs.pair_probability:.2g}"
         + (f", inside seen {obs.interior_seen:g}" if obs.interior_seen > 0 else "") + ")",
         file=obs.source, field="category_prior")
 
@@ -315,11 +316,16 @@ class CompiledTheory:
                  ", ".join(f"{c} {p:g}" for c, p in sorted(obs.category_prior.items(),
                                                           key=lambda kv: -kv[1]) if p > 0))
         reasons.append((f"category prior: {prior}", [rows[("prior", c)] for c in CATEGORIES]))
-        if obs.handles == 2 and obs.parts.get("handle", 0.0) > 0:
-            reasons.append(("observed two handles", [rows[("handles", "pair")]]))
+        if obs.pair_probability > 0 and obs.parts.get("handle", 0.0) > 0:
+            reasons.append(("observed two handles" if obs.pair_probability >= 1 else
+                            f"a second handle unseen, P(pair)={obs.pair_probability:.2g}",
+                            [rows[("handles", "pair")]]))
         if obs.interior_seen > 0:
             reasons.append((f"saw the inside through an open top with P={obs.interior_seen:g}",
                             [rows[("interior", "seen")]]))
+        if obs.interior_hidden > 0:
+            reasons.append((f"looked for the inside and did not see it, P={obs.interior_hidden:g}",
+                            [rows[("interior", "hidden")]]))
         return reasons
 
     def explain(self, obs: Observations, params: np.ndarray,
@@ -404,11 +410,13 @@ class LogicQueryConfig:
     grasp: str = "specific"  # task-dependent grasp model variant: "specific" or "general".
     exclusive: bool = True  # mutually exclusive outcomes (the paper) or normalised marginals.
     use_prior: bool = True  # use the kernel's category prior (PLM); False: uniform (PLM_uniform).
-    prior_floor: float = 0.0  # mix the kernel prior with this much of the uniform prior:
-    # p = (1 − floor)·p_kernel + floor/11. A retrieval prior from 10 neighbours can miss the true
-    # category entirely; without a floor, parts that rule out every category it names make the
-    # observations impossible (probability 0). 0 (the default) is the paper's prior exactly; the
-    # pipeline uses PipelineConfig.prior_floor.
+    prior_floor: float | None = 0.0  # mix the kernel prior with this much of the uniform prior:
+    # p = (1 − floor)·p_kernel + floor/11. A retrieval prior from 10 neighbours weighted
+    # exp(−rank) puts 0.63 on its first neighbour alone and can miss the true category entirely;
+    # without a floor, a wrong first neighbour outweighs the perceived evidence, and parts that
+    # rule out every category it names make the observations impossible (probability 0). 0 is the
+    # paper's prior exactly; None (the pipeline's default): the floor the kernel database fitted
+    # for this kind of query (CategoryDistribution.floor, KernelDatabase.floor).
     explain: bool = True  # attach explanations (one batched circuit pass more per query).
 
     def theory(self) -> TheoryConfig:

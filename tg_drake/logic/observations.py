@@ -67,8 +67,12 @@ class Observations:
     no_hold: tuple[str, ...] = ()  # parts on which no grasp would hold (the feasibility stage):
     # no_hold(Part) evidence (ours, beyond the paper).
     handles: int = 1  # handles seen when the handle part is there: 1, or 2 (a pot's pair).
+    handle_pair: float | None = None  # P(the handle part is a pair, as a pot's) given the view
+    # (`handle_pair_probability`); None: 1 with two handles seen, else 0.
     interior_seen: float = 0.0  # probability that the object's inside was seen through a wide
     # opening (0: not seen, or it could not be: upside down, facing away). Beyond the paper.
+    interior_hidden: float = 0.0  # probability that perception looked for the inside and did
+    # not see it (1 − interior_seen for a perceived object; 0: not looked for). Beyond the paper.
     source: str | None = None  # the file these came from, for error messages.
 
     def __post_init__(self):
@@ -113,12 +117,15 @@ class Observations:
         if self.handles not in (1, 2):
             raise RuleError(f"handles must be 1 or 2, got {self.handles!r}", file=self.source,
                             field="handles")
-        p = self.interior_seen
-        if isinstance(p, bool) or not isinstance(p, int | float) or not math.isfinite(p) \
-                or not 0.0 <= p <= 1.0:
-            raise RuleError(f"interior_seen must be a probability in [0, 1], got {p!r}",
-                            file=self.source, field="interior_seen")
-        self.interior_seen = float(p)
+        for name in ("handle_pair", "interior_seen", "interior_hidden"):
+            p = getattr(self, name)
+            if p is None and name == "handle_pair":
+                continue
+            if isinstance(p, bool) or not isinstance(p, int | float) or not math.isfinite(p) \
+                    or not 0.0 <= p <= 1.0:
+                raise RuleError(f"{name} must be a probability in [0, 1], got {p!r}",
+                                file=self.source, field=name)
+            setattr(self, name, float(p))
 
     # ---- as weights of the compiled schema -------------------------------------------------
 
@@ -133,9 +140,17 @@ class Observations:
             stick_breaking(self.task_vector()),
             np.array([float(p in self.collisions) for p in PART_LABELS]),
             np.array([float(p in self.no_hold) for p in PART_LABELS]),
-            np.array([float(self.handles == 2)]),
+            np.array([self.pair_probability]),
             np.array([self.interior_seen]),
+            np.array([self.interior_hidden]),
         ])
+
+    @property
+    def pair_probability(self) -> float:
+        """P(handle_pair(o)): `handle_pair` when given, else 1 with two handles seen, 0 with one."""
+        if self.handle_pair is not None:
+            return self.handle_pair
+        return float(self.handles == 2)
 
     def containment_vector(self) -> np.ndarray:
         if self.containment is None:  # unknown: either is as likely.
@@ -162,7 +177,8 @@ class Observations:
         if not isinstance(data, dict):
             raise RuleError("an observations file holds a mapping of fields", file=source)
         allowed = ("parts", "pose", "containment", "category_prior", "task", "task_prior",
-                   "collisions", "no_hold", "handles", "interior_seen")
+                   "collisions", "no_hold", "handles", "handle_pair", "interior_seen",
+                   "interior_hidden")
         for key in data:
             if key not in allowed:
                 raise unknown_name("field", key, allowed, error=RuleError, file=source,
@@ -202,8 +218,9 @@ class Observations:
                    collisions=tuple(collisions) if not isinstance(collisions, str)
                    else (collisions,),
                    no_hold=tuple(no_hold) if not isinstance(no_hold, str) else (no_hold,),
-                   handles=handles,
-                   interior_seen=data.get("interior_seen", 0.0), source=source)
+                   handles=handles, handle_pair=data.get("handle_pair"),
+                   interior_seen=data.get("interior_seen", 0.0),
+                   interior_hidden=data.get("interior_hidden", 0.0), source=source)
 
     @classmethod
     def from_file(cls, path: str | Path) -> Observations:
@@ -222,12 +239,13 @@ class Observations:
     @classmethod
     def from_object(cls, obj: ObjectDescription, *,
                     prior: CategoryDistribution | None = None, task: str | None = None,
-                    collisions: tuple[str, ...] = (), prior_floor: float = 0.0,
+                    collisions: tuple[str, ...] = (), prior_floor: float | None = 0.0,
                     no_hold: tuple[str, ...] = ()) -> Observations:
         """From perception's description of one object, the kernel prior (None: uniform), the
         task ("" or None: infer it), the parts the planner could not reach and those on which
         no grasp would hold (`no_hold`). `prior_floor`
-        mixes the prior with the uniform one: (1 − floor)·p + floor/11."""
+        mixes the prior with the uniform one: (1 − floor)·p + floor/11 (None: the prior's own
+        fitted floor, `CategoryDistribution.floor`)."""
         category_prior = None
         if prior is not None:
             p = np.asarray(prior.probabilities, dtype=float)
@@ -235,6 +253,8 @@ class Observations:
                 raise RuleError(f"a category prior has {len(CATEGORIES)} entries, one per "
                                 f"category ({', '.join(CATEGORIES)}); got shape {p.shape}",
                                 field="category_prior")
+            if prior_floor is None:  # the database's fitted floor for this kind of query
+                prior_floor = float(prior.floor)
             if not 0.0 <= prior_floor <= 1.0:
                 raise RuleError(f"prior_floor must lie in [0, 1], got {prior_floor}",
                                 field="prior_floor")
@@ -244,8 +264,9 @@ class Observations:
                    containment=None if obj.containment is None else {obj.containment: 1.0},
                    category_prior=category_prior, task=task or None,
                    collisions=tuple(collisions), no_hold=tuple(no_hold),
-                   handles=count_handles(obj),
-                   interior_seen=float(getattr(obj, "interior_seen", 0.0)))
+                   handles=count_handles(obj), handle_pair=pair_probability_of(obj),
+                   interior_seen=float(obj.interior_seen),
+                   interior_hidden=float(obj.interior_hidden))
 
 
 def count_handles(obj: ObjectDescription) -> int:
@@ -271,6 +292,60 @@ def handle_count(p_O: np.ndarray, labels: np.ndarray) -> int:
     if len(d) == 0:
         return 1
     return 2 if np.linalg.norm(d.mean(axis=0)) < 0.5 else 1
+
+
+# P(pair) of a container whose handle part is there, before the view is weighed: the share of
+# pots (two side handles) among the training containers with a handle part of the object-wise
+# split (scenarios/suites/split.yaml, sets a and b: 5 pots, 5 pans and 5 cups).
+HANDLE_PAIR_PRIOR = 5 / 15
+OPPOSITE_HALF_ANGLE = np.pi / 4  # [rad] the body's side opposite the handle: within ±45° of the
+# direction away from it, about the symmetry axis.
+
+
+def opposite_unseen(p_O: np.ndarray, labels: np.ndarray, visible: np.ndarray) -> float:
+    """The share [0, 1] of the body's points opposite the handle, at the handle's height, that
+    completion added rather than the camera saw: how far the view could have missed a second
+    handle there. p_O: (N, 3) points in the object frame (z the symmetry axis); 1 when no body
+    point lies there (nothing seen of that side); 0 without handle points."""
+    p_O = np.asarray(p_O, dtype=float)
+    handle = np.asarray(labels) == part_index("handle")
+    d = p_O[handle, :2]
+    norm = np.linalg.norm(d, axis=1)
+    if not np.any(norm > 0):
+        return 0.0
+    u = (d[norm > 0] / norm[norm > 0, None]).mean(axis=0)
+    if np.linalg.norm(u) == 0:
+        return 0.0
+    away = -u / np.linalg.norm(u)
+    z = p_O[handle, 2]
+    body = ~handle & (p_O[:, 2] >= z.min()) & (p_O[:, 2] <= z.max())
+    r = np.linalg.norm(p_O[:, :2], axis=1)
+    cos = np.divide(p_O[:, :2] @ away, r, out=np.zeros(len(p_O)), where=r > 0)
+    opposite = body & (cos >= np.cos(OPPOSITE_HALF_ANGLE))
+    if not np.any(opposite):
+        return 1.0
+    return float(1.0 - np.mean(np.asarray(visible, dtype=bool)[opposite]))
+
+
+def handle_pair_probability(handles: int, unseen: float,
+                            prior: float = HANDLE_PAIR_PRIOR) -> float:
+    """P(the handle part is a pair | the view): 1 when two handles are seen; with one seen, Bayes
+    on "a pair's second handle lies where the view did not look" (probability `unseen`) against
+    "a single handle is always the only one seen": prior·unseen / (prior·unseen + 1 − prior)."""
+    if handles == 2:
+        return 1.0
+    num = prior * float(unseen)
+    return num / (num + 1.0 - prior) if num > 0 else 0.0
+
+
+def pair_probability_of(obj: ObjectDescription) -> float:
+    """`handle_pair_probability` of a perceived object, from its cloud in its own frame."""
+    if not obj.part_probabilities.get("handle", 0.0) > 0:
+        return 0.0
+    X_WO = np.asarray(obj.X_WO, dtype=float)
+    p_O = (np.asarray(obj.p_W, dtype=float) - X_WO[:3, 3]) @ X_WO[:3, :3]
+    return handle_pair_probability(count_handles(obj),
+                                   opposite_unseen(p_O, obj.labels, obj.visible))
 
 
 def _distribution(values, names, field_name, kind, source, *, exclusive=True) -> dict[str, float]:
@@ -337,6 +412,7 @@ SCHEMA_PARAMETERS: tuple[tuple[str, str], ...] = (
     + tuple(("no_hold", p) for p in PART_LABELS)
     + (("handles", "pair"),)
     + (("interior", "seen"),)
+    + (("interior", "hidden"),)
 )
 
 # The placeholder weight of schema facts while grounding: anything strictly inside (0, 1) keeps a
@@ -378,6 +454,9 @@ def observation_schema() -> tuple[list[Term], dict[Term, int]]:
     fact = Term("interior_seen", o)
     clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
     rows[fact] = index[("interior", "seen")]
+    fact = Term("interior_hidden", o)
+    clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
+    rows[fact] = index[("interior", "hidden")]
     return clauses, rows
 
 
@@ -407,9 +486,9 @@ def observation_clauses(obs: Observations) -> list[Term]:
         clauses.append(Term("collision", Term(part)))
     for part in obs.no_hold:
         clauses.append(Term("no_hold", Term(part)))
-    if obs.handles == 2:
-        clauses.append(Term("handle_pair", o))
+    fact(Term("handle_pair", o), obs.pair_probability)
     fact(Term("interior_seen", o), obs.interior_seen)
+    fact(Term("interior_hidden", o), obs.interior_hidden)
     # An observation predicate with no clause in this scene (no collision, no pose, ...) is
     # defined as failing, so that ProbLog does not reject the theory's calls to it.
     defined = {_head(c).signature for c in clauses}
@@ -432,7 +511,7 @@ def _schema_heads() -> list[Term]:
     o = _o()
     heads = [Term("part", Term(PART_LABELS[0]), o), Term("collision", Term(PART_LABELS[0])),
              Term("no_hold", Term(PART_LABELS[0])), Term("handle_pair", o),
-             Term("interior_seen", o)]
+             Term("interior_seen", o), Term("interior_hidden", o)]
     for _, group_heads, _ in _ad_groups():
         heads.extend(group_heads)
     return heads

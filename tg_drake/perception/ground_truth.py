@@ -134,4 +134,5 @@ def describe_library_object(obj_id: str, X_WO: np.ndarray, X_WT: np.ndarray, *,
         part_probabilities={name: 1.0 for name in boxes}, part_boxes=boxes,
         pregrasp_X_WG=X_WG, pregrasp_parts=grasp_parts, containment=containment,
         is_tool=obj.is_tool, name=obj_id,
-        interior_seen=interior_visible(obj_id, pose))
+        interior_seen=interior_visible(obj_id, pose),
+        interior_hidden=1.0 - interior_visible(obj_id, pose))

@@ -75,6 +75,7 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
              for name, (centre, half) in parts.boxes.items()}
     X_WG, grasp_parts = part_pregrasps(
         {name: (b.X_WB, b.half_extents) for name, b in boxes.items()}, part_index, cfg.pregrasp)
+    seen = interior_seen(pose, parts.is_tool, cfg.pose)  # perception looked: 1 − seen is hidden
     return ObjectDescription(
         p_W=transform(X_WT, c.p_T), n_W=rotate(X_WT, c.n_T), labels=parts.labels,
         visible=c.visible, X_WO=X_WO, extents=parts.extents, pose=pose.pose,
@@ -84,7 +85,7 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
             *((np.nan, np.nan) if pose.wall is None else (pose.wall.narrowing, pose.wall.error))),
         part_probabilities=parts.probabilities, part_boxes=boxes,
         pregrasp_X_WG=X_WG, pregrasp_parts=grasp_parts, containment=None, is_tool=parts.is_tool,
-        interior_seen=interior_seen(pose, parts.is_tool, cfg.pose))
+        interior_seen=seen, interior_hidden=1.0 - seen)
 
 
 def describe_cloud(p_W: np.ndarray, X_WT: np.ndarray, p_WC: np.ndarray,

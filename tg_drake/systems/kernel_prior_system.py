@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
@@ -43,6 +45,7 @@ class KernelPriorSystem(LeafSystem):
         # The database's cross-validated T and entries for these clouds, unless the config
         # names them; checked now rather than at the first evaluation.
         entries, t = self._database.choice(self._config.clouds or "perceived")
+        self._floor = self._database.floor(self._config.clouds or "perceived")
         self._entries = self._database.resolve_entries(
             entries if self._config.entries is None else self._config.entries)
         self._iterations = self._database.resolve_iterations(
@@ -68,7 +71,8 @@ class KernelPriorSystem(LeafSystem):
     def _calc_category_prior(self, context, output):
         scene: SceneDescription = self._scene_port.Eval(context)
         output.set_value(CategoryPrior(distributions=[
-            self._database.prior(obj.p_W, obj.n_W, obj.labels, t=self._iterations,
-                                 n_neighbours=self._config.n_neighbours,
-                                 entries=self._entries)
+            dataclasses.replace(
+                self._database.prior(obj.p_W, obj.n_W, obj.labels, t=self._iterations,
+                                     n_neighbours=self._config.n_neighbours,
+                                     entries=self._entries), floor=self._floor)
             for obj in scene.objects]))
