@@ -98,14 +98,6 @@ class ScanLike:
 # remeshing
 
 
-def scanlike_library(library: Path | None = None) -> Path:
-    """Where `tools/make_scanlike.py --import` writes the scan-like versions of a library's
-    objects: the cache's scanlike/<library folder name> (None: the shipped library, "objects")."""
-    from tg_drake.importing.library import default_cache_root  # importing loads trimesh, CoACD
-    name = "objects" if library is None else Path(library).resolve().name
-    return default_cache_root().parent / "scanlike" / name
-
-
 def _face_edges(F: np.ndarray) -> np.ndarray:
     """(F, 3, 2) the edges of each face in winding order: (a, b), (b, c), (c, a)."""
     return np.stack([F, np.roll(F, -1, axis=1)], axis=2)

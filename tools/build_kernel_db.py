@@ -76,8 +76,8 @@ def object_ids(which: str, scanlike: bool = False) -> list[str]:
     `scanlike`: with the scan-like version (<id>_scan) of each, from the scan-like libraries
     `tools/make_scanlike.py --all --import [--library L]` writes (registered here)."""
     from tg_drake.evaluation.split import load_split  # a tool: may read the evaluation's split
+    from tg_drake.importing.cache import scanlike_library
     from tg_drake.objects import add_library, load_library
-    from tg_drake.scanlike import scanlike_library
 
     if which == "all-a":
         ids, libraries = list(load_library()), [None]

@@ -37,8 +37,9 @@ import numpy as np
 
 from tg_drake.errors import TgDrakeError
 from tg_drake.evaluation.split import SCANLIKE_SUFFIX
+from tg_drake.importing.cache import scanlike_library
 from tg_drake.objects import add_library, load_library, mesh
-from tg_drake.scanlike import FORMATS, ScanLikeConfig, scanlike_library, write_scanlike
+from tg_drake.scanlike import FORMATS, ScanLikeConfig, write_scanlike
 
 
 def default_out(library: Path | None) -> Path:

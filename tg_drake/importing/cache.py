@@ -53,6 +53,13 @@ def default_cache_root() -> Path:
     return Path(env) if env else Path.home() / ".cache" / "tg_drake" / "objects"
 
 
+def scanlike_library(library: Path | None = None) -> Path:
+    """Where `tools/make_scanlike.py --import` writes the scan-like versions of a library's
+    objects: the cache's scanlike/<library folder name> (None: the shipped library, "objects")."""
+    name = "objects" if library is None else Path(library).resolve().name
+    return default_cache_root().parent / "scanlike" / name
+
+
 def touch(folder: Path) -> None:
     """Records that the import in `folder` was used now (a read-only cache is left as it is)."""
     try:
