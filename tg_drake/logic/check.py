@@ -40,6 +40,7 @@ OBSERVED: dict[tuple[str, int], tuple] = {
     ("full", 1): (ANY,),
     ("handle_pair", 1): (ANY,),
     ("interior_seen", 1): (ANY,),
+    ("task_given", 0): (),
 }
 # Literals that are ProbLog's or Prolog's own, not the theory's predicates.
 BUILTINS = frozenset({"=", "\\=", "==", "\\==", "<", ">", "=<", ">=", "is", "=:=", "=\\=",

@@ -6,6 +6,8 @@ annotated disjunction, or uniform), the given task or a task prior, collision(Pa
 (unreachable parts), no_hold(Part) evidence (parts on which no grasp would hold), the handle
 count, and whether the object's inside was seen through a wide opening (`interior_seen`,
 ours: the paper's parts cannot tell a glass from a can of the same shape; an open top can).
+Whether the task was given enters as the fact `task_given` (the affordances' probabilities are
+those of task prediction: rules/affordances.pl).
 It is validated on construction; bad input raises `RuleError` naming the field and the allowed
 values.
 
@@ -135,6 +137,7 @@ class Observations:
             np.array([float(p in self.no_hold) for p in PART_LABELS]),
             np.array([float(self.handles == 2)]),
             np.array([self.interior_seen]),
+            np.array([float(self.task is not None)]),
         ])
 
     def containment_vector(self) -> np.ndarray:
@@ -337,6 +340,7 @@ SCHEMA_PARAMETERS: tuple[tuple[str, str], ...] = (
     + tuple(("no_hold", p) for p in PART_LABELS)
     + (("handles", "pair"),)
     + (("interior", "seen"),)
+    + (("task_given", "given"),)
 )
 
 # The placeholder weight of schema facts while grounding: anything strictly inside (0, 1) keeps a
@@ -378,6 +382,9 @@ def observation_schema() -> tuple[list[Term], dict[Term, int]]:
     fact = Term("interior_seen", o)
     clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
     rows[fact] = index[("interior", "seen")]
+    fact = Term("task_given")
+    clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
+    rows[fact] = index[("task_given", "given")]
     return clauses, rows
 
 
@@ -410,6 +417,7 @@ def observation_clauses(obs: Observations) -> list[Term]:
     if obs.handles == 2:
         clauses.append(Term("handle_pair", o))
     fact(Term("interior_seen", o), obs.interior_seen)
+    fact(Term("task_given"), float(obs.task is not None))
     # An observation predicate with no clause in this scene (no collision, no pose, ...) is
     # defined as failing, so that ProbLog does not reject the theory's calls to it.
     defined = {_head(c).signature for c in clauses}
@@ -432,7 +440,7 @@ def _schema_heads() -> list[Term]:
     o = _o()
     heads = [Term("part", Term(PART_LABELS[0]), o), Term("collision", Term(PART_LABELS[0])),
              Term("no_hold", Term(PART_LABELS[0])), Term("handle_pair", o),
-             Term("interior_seen", o)]
+             Term("interior_seen", o), Term("task_given")]
     for _, group_heads, _ in _ad_groups():
         heads.extend(group_heads)
     return heads
