@@ -27,12 +27,13 @@ the completed cloud, whose ends may lie past the object's), carried with the obj
 (`turned_about_width`: from the sides the table closed); those whose approach is within
 `max_approach_angle` of the receiver's direction and within its reach are checked by the
 feasibility core (`tg_drake.grasping.feasibility.grasp_feasibility`): clear of the robot's
-gripper — its housing and its pads open, swept back along the robot's retreat — and of the table,
+gripper — its housing and its pads open, swept back along the robot's retreat —, of the robot's
+arm links where the arm stands at the hand-over (the planner's IK) and of the table,
 with something between the pads. Chosen: the best P(part) · P(grasp | local shape) · P(hold) among
 those whose contact mechanics carry the weight (combined margin ≥ 1), else among all.
 
-The receiver's motion (`receiver_motion`, mount joint space, smooth in time): from where it waits
-to its pre-grasp (`approach` back along +y_R from the grasp), a straight approach, the fingers
+The receiver's motion (`receiver_motion`, mount joint space, smooth in time): once the robot has
+arrived, from where it waits to its pre-grasp (`approach` back along +y_R from the grasp), a straight approach, the fingers
 close as the robot's do, and it holds; the robot opens and retreats meanwhile (the planner).
 
 Arrays in, arrays out: no Drake.
@@ -41,6 +42,7 @@ Arrays in, arrays out: no Drake.
 
 
 import functools
+import hashlib
 import math
 from dataclasses import dataclass, field
 
@@ -85,8 +87,8 @@ class ReceiverConfig:
     # direction (90: any approach from its side of the object, from above included)
     max_grasps: int = 48  # of those, the best by P(part) · P(grasp | local shape) checked by the
     # feasibility core per hand-over pose (each check ~10 ms of a 2-core machine's time)
-    speed: float = 0.5  # [m/s] moving to its pre-grasp, while the robot carries the object, so
-    # as to be there when it arrives (peak: 1.875 × the mean) ...
+    speed: float = 0.5  # [m/s] moving to its pre-grasp once the robot has arrived with the
+    # object (peak: 1.875 × the mean) ...
     turn_speed: float = 1.5  # [rad/s] ... and turning (each mount angle)
     approach_speed: float = 0.1  # [m/s] the straight approach (peak: 1.875 × the mean)
     look: float = 0.3  # [s] at its pre-grasp after the robot has arrived, before approaching:
@@ -327,7 +329,8 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
                           X_WO: np.ndarray, X_WO_handover: np.ndarray, X_WG_robot: np.ndarray,
                           receiver_parts: dict, handover: Handover, table_z: float,
                           retreat: float, feasibility: FeasibilityConfig | None = None,
-                          category: dict | None = None, cache: dict | None = None
+                          category: dict | None = None, cache: dict | None = None,
+                          arm_p_W: np.ndarray | None = None
                           ) -> tuple[ReceiverGrasp | None, str]:
     """The receiver's best grasp at the hand-over (module doc), or (None, why there is none).
 
@@ -337,7 +340,8 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     dict kept across the hand-over poses of one planning call: the feasibility of the receiver's
     poses relative to the object and the robot's gripper does not change when the three are
     turned together about the vertical (the planner's place yaws), so it is computed once per
-    robot grasp and set of poses."""
+    robot grasp and set of poses. `arm_p_W`: (N, 3) points on the robot arm's links at the
+    hand-over (`tg_drake.planning.ik.arm_surface_points`), kept clear of as its gripper is."""
     config = handover.config
     feasibility = feasibility or FeasibilityConfig()
     parts = np.asarray(candidates.parts, int)
@@ -371,11 +375,14 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     prior = p_recv[on_part[keep]] * np.asarray(candidates.p_local, float)[on_part[keep]]
     keep = keep[np.argsort(-prior, kind="stable")[:config.max_grasps]]
     X_OG = np.linalg.inv(np.asarray(X_WO_handover, float)) @ np.asarray(X_WG_robot, float)
+    arm = np.zeros((0, 3)) if arm_p_W is None else np.asarray(arm_p_W, float).reshape(-1, 3)
+    X_OW = np.linalg.inv(np.asarray(X_WO_handover, float))
+    arm_O = np.round(arm @ X_OW[:3, :3].T + X_OW[:3, 3], 3)  # the arm as seen from the object
     key = (np.round(X_OG, 6).tobytes(), round(float(X_WO_handover[2, 3]) - table_z, 6),
-           keep.tobytes())
+           keep.tobytes(), hashlib.sha1(arm_O.tobytes()).hexdigest())
     if cache is None or key not in cache:
         target_p_W = (np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3])
-        robot = robot_gripper_points(X_WG_robot, retreat=retreat)
+        robot = np.concatenate([robot_gripper_points(X_WG_robot, retreat=retreat), arm])
         f = grasp_feasibility(X_WR[keep], target_p_W=target_p_W, others_p_W=robot,
                               table_z=table_z, approach=config.approach, category=category,
                               config=feasibility)
@@ -386,8 +393,8 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     ok = np.array([not r for r in f.reasons], bool)
     if not ok.any():
         first = next((r for r in f.reasons if r), "")
-        return None, (f"hand-over: no receiver grasp on {wanted} clear of the robot's fingers "
-                      f"and the table ({len(keep)} tried; first: {first})")
+        return None, (f"hand-over: no receiver grasp on {wanted} clear of the robot's gripper, "
+                      f"its arm and the table ({len(keep)} tried; first: {first})")
     idx = on_part[keep]
     p_local = np.asarray(candidates.p_local, float)[idx]
     score = np.where(ok, p_recv[idx] * p_local * f.p_hold, -1.0)
@@ -529,9 +536,12 @@ def _duration(q_a: np.ndarray, q_b: np.ndarray, speed: float, turn_speed: float,
 def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float,
                     t_earliest: float = 0.0, X_WG_robot: np.ndarray | None = None
                     ) -> HandoverMotion:
-    """From where it waits to its pre-grasp, there when the robot arrives at the hand-over pose
-    (`t_arrive`, plan time) if it can leave early enough (not before `t_earliest`: the object
-    lifted), held there `look` seconds more, the straight approach, closing, held to the end."""
+    """From where it waits to its pre-grasp once the robot has arrived at the hand-over pose
+    (`t_arrive`, plan time; not before `t_earliest`: the object lifted), held there `look`
+    seconds, the straight approach, closing, held to the end. It does not move in while the
+    robot carries and descends: the arm's links sweep through the space around the hand-over
+    pose then (on the lying can, bottle and glass passes of S_GRASP the receiver, there early,
+    was struck by links 5-7 with 130-830 N)."""
     c = handover.config
     q_wait = mount_configuration(handover.X_WR_wait)
     X_pre = np.array(grasp.X_WR, float)
@@ -539,7 +549,7 @@ def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float
     q_pre = mount_configuration(X_pre, near=q_wait)
     q_grasp = mount_configuration(grasp.X_WR, near=q_pre)
     move = _duration(q_wait, q_pre, c.speed, c.turn_speed, 1.0)
-    t_start = max(t_earliest, t_arrive - move)
+    t_start = max(t_earliest, t_arrive)
     t_pre = t_start + move
     t_look = max(t_pre, t_arrive) + c.look
     t_at = t_look + max(0.5, 1.875 * c.approach / c.approach_speed)
