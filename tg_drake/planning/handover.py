@@ -23,18 +23,20 @@ scene it perceives is the table's). Its mount reaches at most `reach` from where
 The receiver's grasp (`choose_receiver_grasp`): the grasp candidates on the parts the logic names
 for a receiver (`tg_drake.logic.receive.receiver_parts`, given the part the robot holds), moved
 along the object's axis onto its observed length (`onto_observed_length`: the part boxes come from
-the completed cloud, whose ends may lie past the object's), carried with the object into its hand-over pose, each also turned ±90° about its pads' width axis
-(`turned_about_width`: from the sides the table closed); those whose approach is within
-`max_approach_angle` of the receiver's direction and within its reach are checked by the
-feasibility core (`tg_drake.grasping.feasibility.grasp_feasibility`): clear of the robot's
-gripper — its housing and its pads open, swept back along the robot's retreat —, of the robot's
-arm links where the arm stands at the hand-over (the planner's IK) and of the table,
-with something between the pads. Chosen: the best P(part) · P(grasp | local shape) · P(hold) among
-those whose contact mechanics carry the weight (combined margin ≥ 1), else among all.
+the completed cloud, whose ends may lie past the object's), carried with the object into its
+hand-over pose, each also turned ±90° about its pads' width axis (`turned_about_width`: from the
+sides the table closed); those whose approach is within `max_approach_angle` of the receiver's
+direction and within its reach are checked by the feasibility core
+(`tg_drake.grasping.feasibility.grasp_feasibility`): clear of the robot's gripper — its housing
+and its pads open, swept back along the robot's retreat —, of the robot arm's links where the arm
+stands at the hand-over (the planner's IK) and of the table, with something between the pads.
+Chosen: the best P(part) · P(grasp | local shape) · P(hold) among those whose contact mechanics
+carry the weight (combined margin ≥ 1), else among all.
 
 The receiver's motion (`receiver_motion`, mount joint space, smooth in time): once the robot has
-arrived, from where it waits to its pre-grasp (`approach` back along +y_R from the grasp), a straight approach, the fingers
-close as the robot's do, and it holds; the robot opens and retreats meanwhile (the planner).
+arrived, from where it waits to its pre-grasp (`approach` back along +y_R from the grasp), a
+straight approach, the fingers close as the robot's do, and it holds; the robot opens and
+retreats meanwhile (the planner).
 
 Arrays in, arrays out: no Drake.
 """
