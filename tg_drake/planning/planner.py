@@ -424,10 +424,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             reason = (f"no candidate of {', '.join(unreachable)} can be picked; first failure: "
                       + first)
         else:
-            place_failures = [r for r in examined if r.startswith(PLACE_FAILURES)]
             reason = ("the object can be picked but not placed at "
                       f"({place_xy[0]:.3f}, {place_xy[1]:.3f}) m: "
-                      + (place_failures or [first])[0])
+                      + max(examined or [first], key=_stage))  # the first farthest
         return PlanResult("unreachable", None, costs, tuple(reasons), part_reachable,
                           unreachable, reason, elapsed)
     return PlanResult("planned", plan, costs, tuple(reasons), part_reachable, unreachable, "",
@@ -435,11 +434,17 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
 
 
 def _farthest(old: str, new: str) -> str:
-    """Of two reasons a candidate's variants failed, the one that got farthest: a place failure
-    (the pick was found) over a pick failure, else the first."""
-    if not old or (new.startswith(PLACE_FAILURES) and not old.startswith(PLACE_FAILURES)):
+    """Of two reasons a candidate's variants failed, the one that got farthest: a pass's receiver
+    failure (the robot's every waypoint was found) over a place failure (the pick was found)
+    over a pick failure, else the first."""
+    if not old or _stage(new) > _stage(old):
         return new
     return old
+
+
+def _stage(reason: str) -> int:
+    return 2 if reason.startswith(RECEIVER_FAILURE) else 1 if reason.startswith(PLACE_FAILURES) \
+        else 0
 
 
 def _place_variants(X_WO_place: np.ndarray, config: PlannerConfig) -> list[np.ndarray]:
@@ -550,6 +555,7 @@ PLACE_FAILURES = ("pre-place pose", "place pose", "retreat pose", "carry traject
                   "descend trajectory", "retreat trajectory", "pour pose", "tilted pose",
                   "tilt trajectory", "untilt trajectory", "return trajectory")  # how their
 # reasons start
+RECEIVER_FAILURE = "hand-over:"  # how the receiver's reasons start (planning.handover)
 POUR_FAILURES = ("pour pose", "tilted pose", "tilt trajectory", "untilt trajectory")
 
 
