@@ -21,11 +21,15 @@ impossible(X, T) :- kind(X, container), full(X), isa_task(T, pour_in).
 impossible(X, T) :- kind(X, container), empty(X), isa_task(T, pour_out).
 impossible(X, T) :- kind(X, open_container), isa_task(T, pp_in_sideways).
 
-% Unusual tasks (ours, the paper's footnote on affordance probabilities for task prediction):
-% possible, but a robot is rarely asked to do them; they keep a small probability. A dish is
-% filled where it stands, and stored upright.
+% Unusual tasks (ours, the paper's footnote: "in the case of task prediction, we use the
+% affordance rules with a high equal probability"): possible, but a robot is rarely asked to do
+% them. A dish is filled where it stands, and stored upright.
 unusual(X, T) :- kind(X, dish), isa_task(T, pour_in).
 unusual(X, T) :- kind(X, dish), isa_task(T, pp_in_upsidedown).
 
+% The probability is one of task prediction: it weighs an unusual task only when the task is
+% inferred (task_given/0, an observation, false). A task the user gives is afforded or not: a
+% glass asked to be stored upside down is grasped for it with the grasp model's odds, undiscounted.
 affords(X, T) :- possible(X, T), \+ impossible(X, T), \+ unusual(X, T).
-0.1::affords(X, T) :- possible(X, T), \+ impossible(X, T), unusual(X, T).
+affords(X, T) :- possible(X, T), \+ impossible(X, T), unusual(X, T), task_given.
+0.1::affords(X, T) :- possible(X, T), \+ impossible(X, T), unusual(X, T), \+ task_given.

@@ -1,7 +1,8 @@
 % Observation vocabulary (paper IV-A): predicates derived from the perceived parts.
 % The observations themselves (part/2, pose/2, empty/1, full/1, handle_pair/1, collision/1,
-% no_hold/1, interior_seen/1, interior_hidden/1, the category prior on cat/2 and the task or task prior on task/1)
-% enter from Python as data: tg_drake/logic/observations.py. The object under query is the
+% no_hold/1, interior_seen/1, interior_hidden/1, the category prior on cat/2, the task or task
+% prior on task/1 and task_given/0, true when the task is given rather than inferred) enter from
+% Python as data: tg_drake/logic/observations.py. The object under query is the
 % constant o.
 
 % tmb(X): X shows the three body parts of a container.

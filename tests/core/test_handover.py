@@ -83,7 +83,7 @@ def test_no_receiver_grasp_clear_of_the_robots_fingers_is_said_so():
     # Both candidates lie where the robot's housing and pads are (x 0.045 … 0.095 m).
     grasp, why = choose([0.06, 0.08], parts={"usable_area": 1.0})
     assert grasp is None
-    assert "clear of the robot's fingers" in why and "other object" in why
+    assert "clear of the robot's gripper" in why and "other object" in why
 
 
 def test_a_receiver_that_cannot_reach_is_said_so():
@@ -138,12 +138,14 @@ def test_the_receivers_motion_reaches_its_grasp_then_closes():
     grasp, _ = choose([-0.07])
     motion = receiver_motion(HANDOVER, grasp, t_arrive=20.0, t_earliest=5.0)
     q_wait = mount_configuration(HANDOVER.X_WR_wait)
-    assert np.allclose(motion.configuration(5.0), q_wait)
+    # It waits while the robot carries (the arm moving past), and leaves once it has arrived.
+    for t in (5.0, 19.9, 20.0):
+        assert np.allclose(motion.configuration(t), q_wait)
     assert np.allclose(motion.velocity(5.0), 0.0)
     assert np.allclose(mount_pose(motion.configuration(motion.times[-1] + 1)), grasp.X_WR)
     t_pre = motion.times[2]
-    assert motion.times[1] > 5.0 and t_pre == pytest.approx(20.0) and motion.t_arrive == 20.0
-    assert motion.times[3] == pytest.approx(20.0 + HANDOVER.config.look)
+    assert motion.times[1] == pytest.approx(20.0) and t_pre > 20.5 and motion.t_arrive == 20.0
+    assert motion.times[3] == pytest.approx(t_pre + HANDOVER.config.look)
     X_pre = mount_pose(motion.configuration(t_pre))
     assert np.allclose(X_pre[:3, 3], grasp.X_WR[:3, 3] - 0.1 * grasp.X_WR[:3, 1])
     assert motion.width(t_pre) == pytest.approx(0.11)
@@ -252,3 +254,61 @@ def test_hand_over_points_out_of_the_arms_reach_for_the_grasp_are_left_out():
     assert wrist_reach_margin(handover.object_pose(X_WO) @ np.linalg.inv(X_WO) @ X_WG) < 0.0
     # Some pose of the list lies out along the robot's radial direction from the point.
     assert any(X[0, 3] > handover.point[0] + 0.05 for X in poses)
+
+
+def lying_can(stray: int = 3) -> ObjectDescription:
+    """A can lying along x_W (its axis z_O = x_W), 10 cm long, radius 3.5 cm, centred at the
+    origin: its upper half observed, the lower half completed, and the completed cloud pushed
+    2 cm past each end (invisible points); `stray` observed points 2 cm past the +x end."""
+    s = np.linspace(-0.05, 0.05, 101)
+    a = np.linspace(0.0, np.pi, 19)
+    S, A = np.meshgrid(s, a, indexing="ij")
+    seen = np.column_stack([S.ravel(), 0.035 * np.cos(A.ravel()), 0.035 * np.sin(A.ravel())])
+    far = np.column_stack([np.linspace(-0.07, 0.07, 141), np.zeros(141), np.full(141, -0.035)])
+    odd = np.tile([0.07, 0.0, 0.035], (stray, 1))
+    p = np.concatenate([seen, far, odd])
+    visible = np.concatenate([np.ones(len(seen), bool), np.zeros(len(far), bool),
+                              np.ones(stray, bool)])
+    X_WO = np.eye(4)
+    X_WO[:3, :3] = np.column_stack([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+    return ObjectDescription(p_W=p, n_W=np.zeros_like(p), labels=np.zeros(len(p), int),
+                             visible=visible, X_WO=X_WO, extents=np.array([0.07, 0.07, 0.14]),
+                             pose="sideways", pose_likelihood={"sideways": 1.0},
+                             part_probabilities={}, part_boxes={},
+                             pregrasp_X_WG=np.zeros((0, 4, 4)), pregrasp_parts=np.zeros(0, int))
+
+
+def test_receiver_grasps_are_moved_onto_the_objects_observed_length():
+    from tg_drake.planning.handover import observed_length, onto_observed_length
+
+    can = lying_can()
+    lo, hi = observed_length(can)
+    assert lo == pytest.approx(-0.05, abs=0.002) and hi == pytest.approx(0.05, abs=0.002)
+    # A top grasp closing across the axis at the completed end (x = 6.5 cm): its pads (2 cm wide
+    # along the axis) end within the observed end; one at the middle stays; an end grasp
+    # approaching along the axis keeps its grasp point at the observed end.
+    across = top_grasp(0.065, 0.0)  # its pads' width axis z_G along −x_W: the can's axis
+    middle = top_grasp(0.0, 0.0)
+    end = side_grasp([0.09, 0.0, 0.0], [-1.0, 0.0, 0.0])  # grasp point at 9 - 5.5 = 3.5 cm
+    end_far = side_grasp([0.12, 0.0, 0.0], [-1.0, 0.0, 0.0])  # grasp point at 6.5 cm
+    moved = onto_observed_length(np.array([across, middle, end, end_far]), can)
+    point = moved[:, :3, 3] + GRASP_DEPTH * moved[:, :3, 1]
+    assert point[0] == pytest.approx([hi - 0.01, 0.0, 0.0], abs=1e-9)
+    assert np.allclose(moved[1], middle) and np.allclose(moved[2], end)
+    assert point[3] == pytest.approx([hi, 0.0, 0.0], abs=1e-9)
+    assert np.allclose(moved[:, :3, :3], np.array([across, middle, end, end_far])[:, :3, :3])
+
+
+def test_the_receiver_keeps_clear_of_the_robots_arm():
+    # Free of the robot's gripper, the handle grasp at x = −0.07 is taken; with an arm link's
+    # points where its pads would be, it is refused and the one at −0.10 taken instead.
+    grasp, _ = choose([-0.07, -0.10])
+    assert grasp is not None and grasp.candidate == 0
+    target = bar(0.3)
+    link = np.array([[-0.07, y, 0.3 + dz] for y in np.linspace(-0.06, 0.06, 25)
+                     for dz in np.linspace(0.02, 0.06, 9)])  # a wall above the handle at −7 cm
+    grasp, _ = choose_receiver_grasp(
+        candidates([-0.07, -0.10]), target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
+        X_WG_robot=top_grasp(0.07, 0.3), receiver_parts={"handle": 0.9, "usable_area": 0.1},
+        handover=HANDOVER, table_z=0.0, retreat=0.1, arm_p_W=link)
+    assert grasp is not None and grasp.candidate == 1

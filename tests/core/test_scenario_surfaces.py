@@ -45,3 +45,16 @@ def test_p_and_p_on_without_surfaces_places_on_the_table():
 def test_bad_surfaces_and_task_fields_name_the_field(text, match):
     with pytest.raises(ScenarioError, match=match):
         load(text)
+
+
+@pytest.mark.parametrize("entry", [
+    "{id: hammer_01, pose: sideways, xy: [0.0, 0.0], containment: full}",
+    "{id: knife_01, pose: sideways, xy: [0.0, 0.0], containment: full}",
+])
+def test_a_full_object_without_a_cavity_is_refused_naming_the_field(entry):
+    # Issue 21's bad input: a full container of an object with no cavity (a tool).
+    with pytest.raises(ScenarioError, match="has no cavity to fill; allowed: empty") as e:
+        load_scenario(scenario_text=f"objects: [{entry}]\ntask: {{task: pourOut}}\n")
+    assert e.value.field == "objects[0].containment"
+    # The same object empty loads.
+    load_scenario(scenario_text=f"objects: [{entry.replace('full', 'empty')}]\n")

@@ -111,8 +111,8 @@ def test_a_knife_is_handed_over_to_the_receiver(cached_run):
 
 def test_a_receiver_that_cannot_reach_fails_the_pass_saying_so():
     # The default cup, its receiver's mount reaching only 0.1 m from where it waits: no plan is
-    # made (the receiver's grasp is checked before any inverse kinematics), nothing is simulated
-    # past planning.
+    # made (the receiver's grasp is checked once the robot's waypoints are solved), nothing is
+    # simulated past planning.
     scenario = load_scenario(TASKS.parent / "default.yaml")
     scenario.receiver = load_scenario(TASKS / "mug_pass.yaml").receiver
     scenario.receiver.reach = 0.1

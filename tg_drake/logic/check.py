@@ -41,6 +41,7 @@ OBSERVED: dict[tuple[str, int], tuple] = {
     ("handle_pair", 1): (ANY,),
     ("interior_seen", 1): (ANY,),
     ("interior_hidden", 1): (ANY,),
+    ("task_given", 0): (),
 }
 # Literals that are ProbLog's or Prolog's own, not the theory's predicates.
 BUILTINS = frozenset({"=", "\\=", "==", "\\==", "<", ">", "=<", ">=", "is", "=:=", "=\\=",

@@ -216,7 +216,9 @@ def grasp_interpretations(records: Sequence[GraspRecord]) -> list[Interpretation
                 continue
             t = Term(TASK_ATOMS[task])
             grasp = [(Term("grasp", o, t, Term(p)), p == r.part) for p in PART_LABELS]
-            out.append(Interpretation(tuple(base + grasp), f"{r.scene}:{r.part}:{task}"))
+            given = [(Term("task_given"), True)]  # the grasp served this task, named for it.
+            out.append(Interpretation(tuple(base + given + grasp),
+                                      f"{r.scene}:{r.part}:{task}"))
     return out
 
 

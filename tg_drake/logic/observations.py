@@ -6,6 +6,8 @@ annotated disjunction, or uniform), the given task or a task prior, collision(Pa
 (unreachable parts), no_hold(Part) evidence (parts on which no grasp would hold), the handle
 count, and whether the object's inside was seen through a wide opening (`interior_seen`,
 ours: the paper's parts cannot tell a glass from a can of the same shape; an open top can).
+Whether the task was given enters as the fact `task_given` (the affordances' probabilities are
+those of task prediction: rules/affordances.pl).
 It is validated on construction; bad input raises `RuleError` naming the field and the allowed
 values.
 
@@ -143,6 +145,7 @@ class Observations:
             np.array([self.pair_probability]),
             np.array([self.interior_seen]),
             np.array([self.interior_hidden]),
+            np.array([float(self.task is not None)]),
         ])
 
     @property
@@ -413,6 +416,7 @@ SCHEMA_PARAMETERS: tuple[tuple[str, str], ...] = (
     + (("handles", "pair"),)
     + (("interior", "seen"),)
     + (("interior", "hidden"),)
+    + (("task_given", "given"),)
 )
 
 # The placeholder weight of schema facts while grounding: anything strictly inside (0, 1) keeps a
@@ -457,6 +461,9 @@ def observation_schema() -> tuple[list[Term], dict[Term, int]]:
     fact = Term("interior_hidden", o)
     clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
     rows[fact] = index[("interior", "hidden")]
+    fact = Term("task_given")
+    clauses.append(fact.with_probability(Constant(PLACEHOLDER)))
+    rows[fact] = index[("task_given", "given")]
     return clauses, rows
 
 
@@ -489,6 +496,7 @@ def observation_clauses(obs: Observations) -> list[Term]:
     fact(Term("handle_pair", o), obs.pair_probability)
     fact(Term("interior_seen", o), obs.interior_seen)
     fact(Term("interior_hidden", o), obs.interior_hidden)
+    fact(Term("task_given"), float(obs.task is not None))
     # An observation predicate with no clause in this scene (no collision, no pose, ...) is
     # defined as failing, so that ProbLog does not reject the theory's calls to it.
     defined = {_head(c).signature for c in clauses}
@@ -511,7 +519,7 @@ def _schema_heads() -> list[Term]:
     o = _o()
     heads = [Term("part", Term(PART_LABELS[0]), o), Term("collision", Term(PART_LABELS[0])),
              Term("no_hold", Term(PART_LABELS[0])), Term("handle_pair", o),
-             Term("interior_seen", o), Term("interior_hidden", o)]
+             Term("interior_seen", o), Term("interior_hidden", o), Term("task_given")]
     for _, group_heads, _ in _ad_groups():
         heads.extend(group_heads)
     return heads

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import Box, CollisionFilterDeclaration, Cylinder, GeometrySet
+from pydrake.geometry import Box, CollisionFilterDeclaration, Cylinder, GeometrySet, Sphere
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.plant import CoulombFriction
@@ -260,3 +260,58 @@ def solve_ik_seeds(arm: ArmPlant, X_WG: RigidTransform, seeds, *,
     else:
         result.reason = f"out of reach within the joint limits (from {len(seeds)} seeds)"
     return result
+
+
+def shape_surface_points(shape, spacing: float) -> np.ndarray:
+    """(N, 3) points on the surface of a Box, Cylinder (along z) or Sphere in its own frame,
+    about `spacing` [m] apart; (0, 3) for another shape."""
+    if isinstance(shape, Sphere):
+        r = shape.radius()
+        n = max(8, int(np.ceil(4 * np.pi * r * r / spacing ** 2)))
+        k = np.arange(n) + 0.5  # a Fibonacci sphere: near-even spacing
+        z = 1 - 2 * k / n
+        a = np.pi * (1 + 5 ** 0.5) * k
+        rho = np.sqrt(1 - z * z)
+        return r * np.column_stack([rho * np.cos(a), rho * np.sin(a), z])
+    if isinstance(shape, Cylinder):
+        r, length = shape.radius(), shape.length()
+        a = np.linspace(0, 2 * np.pi, max(8, int(np.ceil(2 * np.pi * r / spacing))),
+                        endpoint=False)
+        z = np.linspace(-length / 2, length / 2, max(2, int(np.ceil(length / spacing)) + 1))
+        A, Z = np.meshgrid(a, z, indexing="ij")
+        side = np.column_stack([r * np.cos(A.ravel()), r * np.sin(A.ravel()), Z.ravel()])
+        rings = [side]
+        for radius in np.arange(spacing, r, spacing):  # the two end discs, ring by ring
+            b = np.linspace(0, 2 * np.pi, max(6, int(np.ceil(2 * np.pi * radius / spacing))),
+                            endpoint=False)
+            for end in (-length / 2, length / 2):
+                rings.append(np.column_stack([radius * np.cos(b), radius * np.sin(b),
+                                              np.full(len(b), end)]))
+        rings.append(np.array([[0.0, 0.0, -length / 2], [0.0, 0.0, length / 2]]))
+        return np.concatenate(rings)
+    if isinstance(shape, Box):
+        half = np.array([shape.width(), shape.depth(), shape.height()]) / 2
+        axes = [np.linspace(-h, h, max(2, int(np.ceil(2 * h / spacing)) + 1)) for h in half]
+        grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+        return grid[np.any(np.isclose(np.abs(grid), half, rtol=0, atol=1e-12), axis=1)]
+    return np.zeros((0, 3))
+
+
+def arm_surface_points(arm: ArmPlant, q_iiwa, *, spacing: float = 0.01) -> np.ndarray:
+    """(N, 3) world points on the collision shapes of the iiwa's links in configuration `q_iiwa`
+    (the gripper's are not included), about `spacing` [m] apart: what another body near the arm
+    must stay clear of (the receiver of a pass)."""
+    plant = arm.plant
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, arm.full_q(np.asarray(q_iiwa, float)))
+    inspector = arm.scene_graph.model_inspector()
+    out = []
+    for index in plant.GetBodyIndices(arm.iiwa):
+        body = plant.get_body(index)
+        X_WB = plant.EvalBodyPoseInWorld(context, body)
+        for g in plant.GetCollisionGeometriesForBody(body):
+            p = shape_surface_points(inspector.GetShape(g), spacing)
+            if len(p):
+                X_WS = X_WB @ inspector.GetPoseInFrame(g)
+                out.append(p @ X_WS.rotation().matrix().T + X_WS.translation())
+    return np.concatenate(out) if out else np.zeros((0, 3))

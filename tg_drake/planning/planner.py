@@ -57,7 +57,7 @@ from tg_drake.planning.handover import (
     handover_object_poses,
     receiver_motion,
 )
-from tg_drake.planning.ik import ArmPlant, make_arm_plant, solve_ik_seeds
+from tg_drake.planning.ik import ArmPlant, arm_surface_points, make_arm_plant, solve_ik_seeds
 from tg_drake.planning.task_motion import (
     TaskPlacing,
     bowl_of,
@@ -370,14 +370,6 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 reasons[i] = _farthest(reasons[i],
                                        f"{below[0]} pose puts the gripper under the table")
                 break
-            receiving = None
-            if handover is not None:
-                receiving, why = _receiving(handover, candidates, target, part, X_WO,
-                                            X_WO_place_yawed, key, config, table_z, category,
-                                            receiver_cache)
-                if receiving is None:
-                    costs[i], reasons[i] = np.inf, _farthest(reasons[i], why)
-                    continue
             poses, failure = _waypoint_configurations(arms, key, seeds, config)
             if "pre-grasp" in poses:
                 part_reachable[part] = True
@@ -394,6 +386,16 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
                 if picked:
                     continue
                 break
+            receiving = None
+            if handover is not None:  # the receiver clear of the arm as it stands there
+                receiving, why = _receiving(handover, candidates, target, part, X_WO,
+                                            X_WO_place_yawed, key, config, table_z, category,
+                                            receiver_cache,
+                                            arm_p_W=arm_surface_points(arms.free, poses["place"]))
+                if receiving is None:  # picked, not handed over: another place yaw may do
+                    part_pickable[part] |= PICK_POSES <= set(poses)
+                    costs[i], reasons[i] = np.inf, _farthest(reasons[i], why)
+                    continue
             plan, failure, picked = _trajectories(arms, q_start, poses, key, config, seeds,
                                                   candidate=int(i), part=part,
                                                   receiving=receiving)
@@ -422,10 +424,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             reason = (f"no candidate of {', '.join(unreachable)} can be picked; first failure: "
                       + first)
         else:
-            place_failures = [r for r in examined if r.startswith(PLACE_FAILURES)]
             reason = ("the object can be picked but not placed at "
                       f"({place_xy[0]:.3f}, {place_xy[1]:.3f}) m: "
-                      + (place_failures or [first])[0])
+                      + max(examined or [first], key=_stage))  # the first farthest
         return PlanResult("unreachable", None, costs, tuple(reasons), part_reachable,
                           unreachable, reason, elapsed)
     return PlanResult("planned", plan, costs, tuple(reasons), part_reachable, unreachable, "",
@@ -433,11 +434,17 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
 
 
 def _farthest(old: str, new: str) -> str:
-    """Of two reasons a candidate's variants failed, the one that got farthest: a place failure
-    (the pick was found) over a pick failure, else the first."""
-    if not old or (new.startswith(PLACE_FAILURES) and not old.startswith(PLACE_FAILURES)):
+    """Of two reasons a candidate's variants failed, the one that got farthest: a pass's receiver
+    failure (the robot's every waypoint was found) over a place failure (the pick was found)
+    over a pick failure, else the first."""
+    if not old or _stage(new) > _stage(old):
         return new
     return old
+
+
+def _stage(reason: str) -> int:
+    return 2 if reason.startswith(RECEIVER_FAILURE) else 1 if reason.startswith(PLACE_FAILURES) \
+        else 0
 
 
 def _place_variants(X_WO_place: np.ndarray, config: PlannerConfig) -> list[np.ndarray]:
@@ -548,6 +555,7 @@ PLACE_FAILURES = ("pre-place pose", "place pose", "retreat pose", "carry traject
                   "descend trajectory", "retreat trajectory", "pour pose", "tilted pose",
                   "tilt trajectory", "untilt trajectory", "return trajectory")  # how their
 # reasons start
+RECEIVER_FAILURE = "hand-over:"  # how the receiver's reasons start (planning.handover)
 POUR_FAILURES = ("pour pose", "tilted pose", "tilt trajectory", "untilt trajectory")
 
 
@@ -1109,7 +1117,8 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
 
 def _receiving(handover: Handover, candidates: GraspCandidates, target: ObjectDescription,
                part: str, X_WO, X_WO_handover, key: _KeyPoses, config: PlannerConfig,
-               table_z: float, category, cache: dict | None = None):
+               table_z: float, category, cache: dict | None = None,
+               arm_p_W: np.ndarray | None = None):
     """A pass's receiver for one hand-over pose: (plan time of the robot's arrival →
     (HandoverMotion, hold_duration), "") or (None, why): the receiver's grasp on the part the
     logic names for it, given the robot's `part` (tg_drake.logic.receive), chosen by the
@@ -1119,7 +1128,7 @@ def _receiving(handover: Handover, candidates: GraspCandidates, target: ObjectDe
     grasp, why = choose_receiver_grasp(
         candidates, target=target, X_WO=X_WO, X_WO_handover=X_WO_handover,
         X_WG_robot=key.X["place"].GetAsMatrix4(), receiver_parts=parts, handover=handover,
-        table_z=table_z, retreat=config.retreat_distance, cache=cache)
+        table_z=table_z, retreat=config.retreat_distance, cache=cache, arm_p_W=arm_p_W)
     if grasp is None:
         return None, why
     hold = handover.config.hold_duration
