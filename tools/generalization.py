@@ -22,13 +22,15 @@ from tg_drake.evaluation.generalization import compute, markdown
 from tg_drake.evaluation.split import load_split
 
 COMMAND = ("nice -n 10 tg-drake eval scenarios/suites/generalization.yaml --out /tmp/gen\n"
+           "nice -n 10 tg-drake eval scenarios/suites/generalization_executed.yaml --out "
+           "/tmp/gen_exec\n"
            "# scan-like columns: their libraries, then their suite\n"
            "python tools/make_scanlike.py --all --import\n"
            "python tools/make_scanlike.py --all --import --library models/objects_b\n"
            "nice -n 10 tg-drake eval scenarios/suites/generalization_scanlike.yaml --out "
            "/tmp/gen_scan\n"
-           "python tools/generalization.py /tmp/gen/results.jsonl /tmp/gen_scan/results.jsonl "
-           "--out docs/results/generalization")
+           "python tools/generalization.py /tmp/gen/results.jsonl /tmp/gen_exec/results.jsonl "
+           "/tmp/gen_scan/results.jsonl --out docs/results/generalization")
 
 
 def read_records(paths) -> list[dict]:
