@@ -181,3 +181,37 @@ def test_a_thin_slab_on_the_table_is_found_through_the_d415_and_the_table_alone_
         assert off.mean() < 0.05
         np.testing.assert_allclose((lo + hi) / 2, [0.0, 0.0], atol=0.01)
         assert np.median(p_W[:, 2]) == pytest.approx(thickness, abs=0.001)
+
+
+def _wall(rng, centre, radius, angles, z_top, n=1500):
+    """Points on a vertical wall: the arc of a circle (centre, radius [m]) over `angles` [rad],
+    from 4 mm to z_top [m] above the table (voxel-sized spacing)."""
+    a = rng.uniform(*angles, n)
+    z = rng.uniform(0.004, z_top, n)
+    return np.column_stack([centre[0] + radius * np.cos(a), centre[1] + radius * np.sin(a), z])
+
+
+def test_the_near_and_far_walls_of_an_open_container_are_one_object():
+    from tg_drake.perception.segmentation import _merge_shared_rims, fit_circle
+
+    rng = np.random.default_rng(4)
+    cfg = SegmentationConfig()
+    # A wide pot seen from the front: its near wall and its far wall, the rim's sides lost.
+    near = _wall(rng, (0.0, 0.0), 0.11, (-2.2, -0.9), 0.15)
+    far = _wall(rng, (0.0, 0.0), 0.11, (0.9, 2.2), 0.15)
+    q = np.concatenate([near, far])
+    labels = np.r_[np.zeros(len(near), int), np.ones(len(far), int)]
+    assert list(_merge_shared_rims(q, labels, 2, cfg)) == [0, 0]
+    _, radius, rms = fit_circle(q[q[:, 2] > 0.14][:, :2])
+    assert radius == pytest.approx(0.11, abs=0.002) and rms < 0.001
+    # Two cups of one height side by side: their rims are two circles, not one.
+    a = _wall(rng, (0.0, 0.0), 0.04, (-np.pi, np.pi), 0.1)
+    b = _wall(rng, (0.12, 0.0), 0.04, (-np.pi, np.pi), 0.1)
+    q = np.concatenate([a, b])
+    labels = np.r_[np.zeros(len(a), int), np.ones(len(b), int)]
+    assert list(_merge_shared_rims(q, labels, 2, cfg)) == [0, 1]
+    # The far wall of a lower object behind: tops at other heights stay apart.
+    low = _wall(rng, (0.0, 0.0), 0.11, (0.9, 2.2), 0.08)
+    q = np.concatenate([near, low])
+    labels = np.r_[np.zeros(len(near), int), np.ones(len(low), int)]
+    assert list(_merge_shared_rims(q, labels, 2, cfg)) == [0, 1]

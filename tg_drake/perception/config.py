@@ -46,6 +46,13 @@ class SegmentationConfig:
     cluster_min_points: int = 4  # DBSCAN core-point neighbour count (voxels).
     min_cluster_points: int = 40  # smaller clusters are noise (voxels).
     merge_max_gap: float = 0.05  # clusters touching in the image this close in depth merge [m].
+    # Two clusters whose tops lie on one circle are the two sides of one open container whose rim
+    # between them the camera lost (segmentation._merge_shared_rims): their tops (the points within
+    # rim_band of each cluster's highest) at heights within rim_band of each other, one circle
+    # through both with an RMS distance of at most rim_fit_rms [m] (twice the D415's 2 mm noise at
+    # 1 m).
+    rim_band: float = 0.01  # [m]
+    rim_fit_rms: float = 0.004  # [m]
     border_margin_px: int = 2  # a cluster with a pixel this close to the image edge is cut [px].
     drop_border_objects: bool = True  # drop objects cut by the image border (else keep them).
     seed: int = 0  # seeds the table's RANSAC (a generator made from it for each table search;

@@ -212,6 +212,45 @@ def _merge_occluded(labels_px: np.ndarray, p_px: np.ndarray, rows: np.ndarray, c
     return parent
 
 
+def fit_circle(xy: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """(centre (2,), radius, RMS distance to the circle) [m] of the least-squares (Kåsa) circle
+    through points xy (N, 2), N ≥ 3."""
+    A = np.column_stack([2 * xy, np.ones(len(xy))])
+    b = (xy ** 2).sum(axis=1)
+    (cx, cy, k), *_ = np.linalg.lstsq(A, b, rcond=None)
+    centre = np.array([cx, cy])
+    radius = float(np.sqrt(max(k + cx * cx + cy * cy, 0.0)))
+    rms = float(np.sqrt(np.mean((np.linalg.norm(xy - centre, axis=1) - radius) ** 2)))
+    return centre, radius, rms
+
+
+def _merge_shared_rims(q: np.ndarray, labels: np.ndarray, n: int, cfg: SegmentationConfig
+                       ) -> np.ndarray:
+    """Cluster id → merged cluster id, joining two clusters whose tops lie on one circle: the
+    near and the far wall of an open container whose rim between them the camera lost (a wide
+    pot seen from above: the inside's floor hidden, the rim's sides thinner than the sensor's
+    edge losses). q: (M, 3) voxel points in T [m]; labels (M,) their cluster (−1: noise)."""
+    tops = []
+    for k in range(n):
+        z = q[labels == k, 2]
+        tops.append((q[labels == k][z >= z.max() - cfg.rim_band] if len(z) else q[:0],
+                     z.max() if len(z) else np.nan))
+    parent = np.arange(n)
+    for i in range(n):
+        for j in range(i + 1, n):
+            (ti, zi), (tj, zj) = tops[i], tops[j]
+            if len(ti) < 3 or len(tj) < 3 or not abs(zi - zj) <= cfg.rim_band:
+                continue
+            both = np.concatenate([ti[:, :2], tj[:, :2]])
+            centre, radius, rms = fit_circle(both)
+            # Each top alone must be an arc of that circle, not a blob beside it.
+            if rms <= cfg.rim_fit_rms and radius > 0 and all(
+                    np.ptp(t[:, :2], axis=0).max() >= radius for t in (ti, tj)):
+                a, b = parent[i], parent[j]
+                parent[parent == max(a, b)] = min(a, b)
+    return parent
+
+
 def _clusters(idx: np.ndarray, p_T: np.ndarray, pixels: np.ndarray,
               image_size: tuple[int, int], cfg: SegmentationConfig
               ) -> list[tuple[np.ndarray, bool, np.ndarray]]:
@@ -235,6 +274,8 @@ def _clusters(idx: np.ndarray, p_T: np.ndarray, pixels: np.ndarray,
         merged = _merge_occluded(labels[voxel][keep_px], p[keep_px], r[keep_px], c[keep_px],
                                  image_size, n_clusters, cfg.merge_max_gap)
         labels = np.where(labels >= 0, merged[labels], -1)
+        rims = _merge_shared_rims(q, labels, n_clusters, cfg)
+        labels = np.where(labels >= 0, rims[np.maximum(labels, 0)], -1)
     order = np.argsort(labels, kind="stable")
     bounds = np.searchsorted(labels[order], np.arange(n_clusters + 1))
     out = []
