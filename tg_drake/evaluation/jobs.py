@@ -177,8 +177,8 @@ def setting_observations(description, setting: str, *, true_pose: str, containme
     else:
         parts, pose = detected, dict(description.pose_likelihood)
     return Observations(parts=parts, pose=pose, containment={containment: 1.0},
-                        handles=count_handles(description),
-                        handle_pair=pair_probability_of(description),
+                        handles=(n := count_handles(description)),
+                        handle_pair=pair_probability_of(description, n),
                         interior_seen=description.interior_seen,
                         interior_hidden=description.interior_hidden)
 

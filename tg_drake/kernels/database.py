@@ -120,6 +120,7 @@ class KernelDatabase:
         self.resolve_entries(self.entries_default)
         self.resolve_entries(self.entries_ground_truth)
         self._self_kernels = self.features.self_kernels()
+        self._source_ids = source_objects(self.object_ids)  # for leave-one-object-out
 
     @property
     def t_max(self) -> int:
@@ -221,7 +222,7 @@ class KernelDatabase:
         mask = self.entry_mask(entries)
         sim = np.where(mask, self.similarities(points, normals, labels, t=t), -np.inf)
         if exclude_object is not None:  # the object and its scan-like version or original
-            own = source_objects(self.object_ids) == source_objects(exclude_object)[0]
+            own = self._source_ids == source_objects(exclude_object)[0]
             sim = np.where(own, -np.inf, sim)
         priors, neighbours = category_priors(sim, self.categories, n_neighbours=n_neighbours)
         return CategoryDistribution(

@@ -267,16 +267,20 @@ class Observations:
                    containment=None if obj.containment is None else {obj.containment: 1.0},
                    category_prior=category_prior, task=task or None,
                    collisions=tuple(collisions), no_hold=tuple(no_hold),
-                   handles=count_handles(obj), handle_pair=pair_probability_of(obj),
+                   handles=(n := count_handles(obj)), handle_pair=pair_probability_of(obj, n),
                    interior_seen=float(obj.interior_seen),
                    interior_hidden=float(obj.interior_hidden))
 
 
+def _points_O(obj: ObjectDescription) -> np.ndarray:
+    """(N, 3) a perceived object's cloud in its own frame (z the symmetry axis) [m]."""
+    X_WO = np.asarray(obj.X_WO, dtype=float)
+    return (np.asarray(obj.p_W, dtype=float) - X_WO[:3, 3]) @ X_WO[:3, :3]
+
+
 def count_handles(obj: ObjectDescription) -> int:
     """1 or 2 handles on a perceived object (`handle_count` on its cloud in its own frame)."""
-    X_WO = np.asarray(obj.X_WO, dtype=float)
-    p_O = (np.asarray(obj.p_W, dtype=float) - X_WO[:3, 3]) @ X_WO[:3, :3]
-    return handle_count(p_O, np.asarray(obj.labels))
+    return handle_count(_points_O(obj), np.asarray(obj.labels))
 
 
 def handle_count(p_O: np.ndarray, labels: np.ndarray) -> int:
@@ -341,14 +345,15 @@ def handle_pair_probability(handles: int, unseen: float,
     return num / (num + 1.0 - prior) if num > 0 else 0.0
 
 
-def pair_probability_of(obj: ObjectDescription) -> float:
-    """`handle_pair_probability` of a perceived object, from its cloud in its own frame."""
+def pair_probability_of(obj: ObjectDescription, handles: int | None = None) -> float:
+    """`handle_pair_probability` of a perceived object, from its cloud in its own frame
+    (`handles`: its `count_handles`, when already counted)."""
     if not obj.part_probabilities.get("handle", 0.0) > 0:
         return 0.0
-    X_WO = np.asarray(obj.X_WO, dtype=float)
-    p_O = (np.asarray(obj.p_W, dtype=float) - X_WO[:3, 3]) @ X_WO[:3, :3]
-    return handle_pair_probability(count_handles(obj),
-                                   opposite_unseen(p_O, obj.labels, obj.visible))
+    p_O = _points_O(obj)
+    if handles is None:
+        handles = handle_count(p_O, np.asarray(obj.labels))
+    return handle_pair_probability(handles, opposite_unseen(p_O, obj.labels, obj.visible))
 
 
 def _distribution(values, names, field_name, kind, source, *, exclusive=True) -> dict[str, float]:
