@@ -2,14 +2,20 @@
 
 Each figure is a function returning a `Figure`; stages register theirs in FIGURES
 (name → "module:function").
-Output: one JSON object, figure name → {median, unit, reference, reference_median, speedup}.
+Output: one JSON object, figure name → {median, unit, reference, reference_median, speedup}, and
+"_run": where and how it was measured (the command, commit, date, cores, load average at the start,
+package versions, wall time), since every figure is of one machine on one day.
 """
 
 from __future__ import annotations
 
+import datetime
 import importlib
 import json
+import os
+import platform
 import statistics
+import subprocess
 import sys
 import time
 from collections.abc import Callable
@@ -82,14 +88,51 @@ def rounded(value, digits: int = 4):
     return value
 
 
+def _commit() -> str | None:
+    """The checkout's commit (+"+dirty" with uncommitted changes); None outside git."""
+    root = Path(__file__).resolve().parent.parent
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, text=True,
+                              capture_output=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
+                               text=True, capture_output=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return head + ("+dirty" if dirty else "")
+
+
+def run_info(argv: list[str] | None = None) -> dict:
+    """Where and how the figures were measured (stored beside them as "_run")."""
+    from importlib.metadata import PackageNotFoundError, version
+    versions = {}
+    for name in ("drake", "numpy", "open3d", "problog", "scikit-learn"):
+        try:
+            versions[name] = version(name)
+        except PackageNotFoundError:
+            versions[name] = None
+    return {
+        "command": "tg-drake bench" + "".join(f" {a}" for a in (argv or [])),
+        "commit": _commit(),
+        "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "cpus": os.cpu_count(),
+        "load_average_1min_at_start": round(os.getloadavg()[0], 2),
+        "machine": f"{platform.system()} {platform.machine()}, Python {platform.python_version()}",
+        "versions": versions,
+    }
+
+
 def main(args) -> int:
     names = args.only or list(FIGURES)
+    argv = [f"--only {n}" for n in args.only or []] + ([f"--out {args.out}"] if args.out else [])
+    info = run_info(argv)
+    t0 = time.perf_counter()
     results = {}
     for name in names:
         module_name, function_name = FIGURES[name].split(":")
         fn = getattr(importlib.import_module(module_name), function_name)
         results[name] = rounded(asdict(fn()))
         print(f"{name}: {results[name]}", file=sys.stderr, flush=True)  # progress: stdout is JSON
+    results["_run"] = {**info, "wall_s": round(time.perf_counter() - t0, 1)}
     text = json.dumps(results, indent=2)
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)

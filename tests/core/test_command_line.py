@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 import socket
 from pathlib import Path
@@ -109,6 +110,9 @@ def test_bench_writes_only_json_on_stdout_with_rounded_figures(capsys, monkeypat
     data = json.loads(out.out)  # nothing but the JSON
     assert data["fake"]["median"] == 1.085 and data["fake"]["speedup"] == 1060.0
     assert "fake:" in out.err  # the progress line
+    run = data["_run"]  # where and how: the figures are of one machine on one day
+    assert run["command"] == "tg-drake bench --only fake" and run["cpus"] == os.cpu_count()
+    assert run["wall_s"] >= 0 and run["versions"]["drake"]
 
 
 def _fake_figure():
