@@ -89,7 +89,7 @@ def rounded(value, digits: int = 4):
 
 
 def _commit() -> str | None:
-    """The checkout's commit (+"+dirty" with uncommitted changes); None outside git."""
+    """The checkout's short commit, "+dirty" when tracked files changed; None outside git."""
     root = Path(__file__).resolve().parent.parent
     try:
         head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, text=True,

@@ -137,6 +137,8 @@ def result_of(*, scenario, scenario_path: str, stages: Stages, outcome, plan_sta
                                "p_hold": (float(ranked.p_hold[i]) if known
                                           and ranked.p_hold is not None else None),
                                "score": float(ranked.score[i]) if known else None}
+            if known and i < len(ranked.holds):  # the feasibility stage's contact mechanics
+                result["grasp"]["hold"] = ranked.holds[i].summary()
             if stages.scored is not None:
                 result["grasp"]["scored_pose"] = _scored_pose_json(plan_status.X_WG,
                                                                    stages.scored)

@@ -207,3 +207,5 @@ class GraspCandidates:
     source: np.ndarray | None = None  # (M,) the scored hypothesis each pose was made from (the
     # approach variants of one hypothesis share it); None: each row is its own.
     unholdable_parts: tuple = ()  # parts that have candidates, none of which would hold
+    holds: tuple = ()  # (M,) each pose's contact mechanics (grasping.feasibility.Hold); () when
+    # not assessed.

@@ -16,6 +16,7 @@ from tg_drake.grasping.feasibility import (
     hull_volume,
     load_hold_model,
     mean_density,
+    point_normals,
 )
 from tg_drake.robot import WSG_MAX_OPENING, WSG_PAD_SIZE
 
@@ -122,6 +123,60 @@ def test_a_lever_too_long():
     assert margins[1] / margins[2] == pytest.approx(3.0, rel=0.05)
 
 
+def lying_cylinder(radius, length, axis_z, spacing=0.002):
+    """Points on a closed cylinder lying along y_W, its axis at height axis_z (x_W = 0)."""
+    phi = np.arange(0.0, 2 * np.pi, spacing / radius)
+    y = np.arange(-length / 2, length / 2 + 1e-9, spacing)
+    P, Y = np.meshgrid(phi, y)
+    side = np.column_stack([radius * np.cos(P.ravel()), Y.ravel(),
+                            axis_z + radius * np.sin(P.ravel())])
+    r = np.arange(spacing, radius, spacing)
+    R, Q = np.meshgrid(r, np.arange(0.0, 2 * np.pi, spacing / radius))
+    disc = np.column_stack([R.ravel() * np.cos(Q.ravel()), R.ravel() * np.sin(Q.ravel())])
+    caps = [np.column_stack([disc[:, 0], np.full(len(disc), e), axis_z + disc[:, 1]])
+            for e in (-length / 2, length / 2)]
+    return np.concatenate([side, *caps])
+
+
+def test_a_round_body_pinched_past_its_widest_section_is_squeezed_out():
+    # A 66 mm can lying on its side, pinched across its diameter from above (x_G horizontal).
+    # Through its axis the pads press where the surface faces them: no squeeze. With the axis
+    # 30 mm past the fingertips the pads' tips press where the surface leans
+    # asin(30 / 33) = 65° away: the grip pushes it out of the hand with N tan 65° per pad, more
+    # than friction (μ = 1) carries — whatever it weighs.
+    R, axis_z = 0.033, 0.033
+    can = lying_cylinder(R, 0.12, axis_z)
+    normals = point_normals(can)
+    centred = hold(top_down((0, 0, axis_z)), target_p_W=can, mass=0.015, config=CONFIG,
+                   normals_W=normals)
+    assert centred.squeeze < 0.1 and centred.width == pytest.approx(2 * R, abs=0.002)
+    tip_y = WSG_PAD_SIZE[1] / 2  # the fingertips lie this far past the grasp point
+    X = top_down((0, 0, axis_z + tip_y + 0.030))
+    past = hold(X, target_p_W=can, mass=0.015, config=CONFIG, normals_W=normals)
+    lean = np.arcsin(0.030 / R)
+    assert past.squeeze == pytest.approx(np.tan(lean) / CONFIG.friction, rel=0.25)
+    assert past.squeeze > 1.0 and past.margin < 1.0
+    assert hold(X, target_p_W=can, mass=0.015, config=CONFIG).squeeze == 0.0  # no normals
+    f = grasp_feasibility(np.stack([top_down((0, 0, axis_z)), X]), target_p_W=can,
+                          others_p_W=np.zeros((0, 3)), table_z=-1.0, approach=0.1,
+                          category={"can": 1.0}, config=CONFIG)
+    assert f.reasons[0] == "" and f.p_hold[0] > 0
+    assert "squeezes it out" in f.reasons[1] and f.p_hold[1] == 0.0
+
+
+def test_flat_faces_are_hardly_squeezed():
+    # A box's faces face the pads: over the whole face no squeeze; with the pads over the top
+    # half only, the points' normals blur around the top edge (k-nn normals mix the two faces
+    # there) and lean a little: still far inside the friction cone.
+    box = box_surface((0.05, 0.04, 0.06), centre=(0, 0, 0.03))
+    normals = point_normals(box)
+    whole = hold(top_down((0, 0, 0.03)), target_p_W=box, mass=0.1, config=CONFIG,
+                 normals_W=normals)
+    top = hold(top_down((0, 0, 0.06)), target_p_W=box, mass=0.1, config=CONFIG,
+               normals_W=normals)
+    assert whole.squeeze < 0.01 and top.n_points > 0 and top.squeeze < 0.1
+
+
 def test_mass_from_volume_and_the_category_distribution():
     cube = box_surface((0.1, 0.1, 0.1))
     assert hull_volume(cube) == pytest.approx(1e-3, rel=1e-6)
@@ -166,7 +221,8 @@ def test_the_assessed_candidates_keep_the_scorers_score(monkeypatch):
     from tg_drake.types import GraspCandidates, ObjectDescription, SceneDescription
 
     monkeypatch.setattr(feasibility, "grasp_feasibility", lambda X_WG, **kw: SimpleNamespace(
-        reasons=["", "", "in collision with the table", ""], p_hold=np.full(len(X_WG), 0.5)))
+        reasons=["", "", "in collision with the table", ""], p_hold=np.full(len(X_WG), 0.5),
+        holds=(None,) * len(X_WG)))
     obj = ObjectDescription(
         p_W=np.zeros((10, 3)), n_W=np.zeros((10, 3)), labels=np.zeros(10, int),
         visible=np.ones(10, bool), X_WO=np.eye(4), extents=np.full(3, 0.1), pose="upright",

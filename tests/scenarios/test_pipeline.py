@@ -54,6 +54,11 @@ def check_result_keys(result: dict) -> None:
         ranked_by_hold = result["config"]["pipeline"]["feasibility"]["rank_by_hold"]
         p_hold = g["p_hold"] if ranked_by_hold and g.get("p_hold") is not None else 1.0
         assert g["score"] == pytest.approx(g["p_part"] * g["p_local"] * p_hold, rel=1e-6)
+        # Its contact mechanics on the perceived points: a pose the stage let through is not
+        # one the grip squeezes out.
+        h = g["hold"]
+        assert h["squeeze"] is not None and 0.0 <= h["squeeze"] < 1.0
+        assert h["width_mm"] > 0 and h["mass_kg"] > 0 and h["patch_area_mm2"] > 0
     assert all(v >= 0 for v in result["timings"].values())
 
 

@@ -19,9 +19,16 @@ fingers close along ±x_G, approach along +y_G, z_G across the pads):
     the logic's category distribution) and the lever of its weight about the closing axis give
     the wrench the patches must carry under the lift and carry
     accelerations and the wrench they can carry: a translational, a torsional and a combined
-    margin (elliptic limit surface: margin < 1 slips).
+    margin (elliptic limit surface: margin < 1 slips). A pad presses along x_G, but the object
+    pushes back along its own surface normal there: where that normal leans away from x_G (a
+    round body pinched past its widest section, by the pads' tips) the grip itself pushes the
+    object along the pads' faces, out of the hand — the "squeeze", N tan θ per pad, which
+    friction must carry before any load; a squeeze of friction's whole capacity (`squeeze` ≥ 1,
+    tan θ ≥ μ: the contact force outside the friction cone) cannot hold whatever the object
+    weighs, and such a pose is infeasible.
 (c) P(hold | features) — a logistic regression on the margins and patch features, fitted on
-    physics episodes of training objects (tools/fit_hold_model.py; tg_drake/data/hold_model.json).
+    physics episodes of training objects (tools/fit_hold_model.py; tg_drake/data/hold_model.json;
+    the shipped fit predates the squeeze's share of the margin: refit it with new episodes).
 
 Arrays in, arrays out: no Drake.
 """
@@ -34,7 +41,7 @@ from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError
+from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from tg_drake.errors import ModelError, ScenarioError
 from tg_drake.robot import (
@@ -215,12 +222,23 @@ class Hold:
     torque_capacity: float  # [N·m] torque about x_G they carry by friction
     translational_margin: float  # capacity / the largest tangential load (inf: no load)
     torsional_margin: float  # capacity / the largest torque about x_G
-    margin: float  # the combined (elliptic limit surface) margin: < 1 slips
+    margin: float  # the combined (elliptic limit surface) margin, the squeeze included: < 1 slips
     pad_cut: float = 0.0  # [m] how deep the target's points cut the open pads' approach sweep
     housing_cut: float = 0.0  # [m] … and the housing's: the gripper pushes the object there
+    squeeze: float = 0.0  # the share of the pads' friction their own grip uses up pushing the
+    # object along their faces, out of the hand (|Σ tan θ| / 2μ over the two patches' mean
+    # surface normals): ≥ 1 squeezes it out at any weight; 0 without normals
 
     def features(self) -> np.ndarray:
         return hold_feature_vector(self)
+
+    def summary(self) -> dict:
+        """The figures result.json reports for the executed grasp (SI units in the names)."""
+        def r(x, digits=4):
+            return None if not np.isfinite(x) else round(float(x), digits)
+        return {"margin": r(self.margin), "squeeze": r(self.squeeze),
+                "width_mm": r(self.width * 1e3, 2), "patch_area_mm2": r(self.patch_area * 1e6, 1),
+                "lever_mm": r(self.lever * 1e3, 1), "mass_kg": r(self.mass)}
 
 
 # The model's inputs: the combined margin carries the mass, the friction, the force and the lever
@@ -263,6 +281,42 @@ def hull_volume(p_W: np.ndarray) -> float:
         return 0.0
 
 
+NORMAL_NEIGHBOURS = 12  # k of the k-nearest-neighbour normals (perception's completion uses 12)
+
+
+def point_normals(p: np.ndarray, k: int = NORMAL_NEIGHBOURS) -> np.ndarray:
+    """(n, 3) unit surface normals of points p (n, 3), unoriented: the direction of least spread
+    of each point's k nearest neighbours (zeros for fewer than 3 points)."""
+    p = np.asarray(p, float).reshape(-1, 3)
+    if len(p) < 3:
+        return np.zeros_like(p)
+    _, idx = cKDTree(p).query(p, k=min(k, len(p)))
+    q = p[idx] - p[idx].mean(axis=1, keepdims=True)
+    _, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", q, q))
+    return vectors[:, :, 0]  # eigenvalues ascend: the first is the normal
+
+
+def squeeze_tangent(n_G: np.ndarray, side: float, weights: np.ndarray | None = None
+                    ) -> np.ndarray:
+    """(2,) how a pad pressing along side·x_G (−1: the left pad, at the object's −x side) pushes
+    the object along the pad's face, per unit of grip: the (y_G, z_G) part of the contact force
+    along the `weights`-weighted mean outward surface normal of the patch's points n_G (m, 3),
+    scaled to a unit x_G part (magnitude tan θ, θ the normal's lean from x_G). Zero without
+    normals."""
+    n = np.asarray(n_G, float).reshape(-1, 3)
+    if not len(n):
+        return np.zeros(2)
+    n = n * np.where(n[:, 0] * side < 0, -1.0, 1.0)[:, None]  # outward: towards the pad
+    w = np.ones(len(n)) if weights is None else np.asarray(weights, float)
+    if w.sum() <= 0:
+        return np.zeros(2)
+    mean = w @ n / w.sum()
+    if abs(mean[0]) < 1e-9:
+        return np.zeros(2)
+    # The pad pushes the object along −n; per unit of its x_G part: −n / |n_x|.
+    return -mean[1:] / abs(mean[0])
+
+
 def _patch(q: np.ndarray, cell: float) -> tuple[float, float, np.ndarray, float]:
     """(area, smaller extent, centre (y, z), mean cell distance from the centre) of patch points
     q (n, 2) in a pad's face coordinates."""
@@ -277,19 +331,20 @@ def _patch(q: np.ndarray, cell: float) -> tuple[float, float, np.ndarray, float]
 
 def hold(X_WG: np.ndarray, *, target_p_W: np.ndarray, mass: float,
          config: FeasibilityConfig, p_WCoM: np.ndarray | None = None,
-         approach: float = 0.0) -> Hold:
+         approach: float = 0.0, normals_W: np.ndarray | None = None) -> Hold:
     """The hold of grasp X_WG on the target's points (the completed cloud), an object of `mass`
     [kg] with its centre of mass at p_WCoM (default: the points' centroid); the target's cut of
     the open gripper swept `approach` [m] along its approach (the gripper pushes the object
-    there: whether it still holds is the fitted model's to say)."""
+    there: whether it still holds is the fitted model's to say). `normals_W`: the points' surface
+    normals (`point_normals`, any sign) for the squeeze; None: no squeeze."""
     p_W = np.asarray(target_p_W, float)
     com = p_W.mean(axis=0) if p_WCoM is None and len(p_W) else np.asarray(p_WCoM, float)
     R, t = X_WG[:3, :3], X_WG[:3, 3]
     p_G = (p_W - t) @ R
     y0, y1 = WSG_GRASP_POINT_G[1] - WSG_PAD_SIZE[1] / 2, WSG_GRASP_POINT_G[1] + WSG_PAD_SIZE[1] / 2
-    between = p_G[(p_G[:, 1] >= y0) & (p_G[:, 1] <= y1)
-                  & (np.abs(p_G[:, 2]) <= WSG_PAD_SIZE[2] / 2)
-                  & (np.abs(p_G[:, 0]) <= config.opening / 2)]
+    inside = ((p_G[:, 1] >= y0) & (p_G[:, 1] <= y1) & (np.abs(p_G[:, 2]) <= WSG_PAD_SIZE[2] / 2)
+              & (np.abs(p_G[:, 0]) <= config.opening / 2))
+    between = p_G[inside]
     N = min(config.grip_force, WSG_FORCE_LIMIT)
     mu = config.friction
     cut = penetration(X_WG, p_W, gripper_boxes(config.opening, approach), config.min_points)
@@ -300,13 +355,24 @@ def hold(X_WG: np.ndarray, *, target_p_W: np.ndarray, mass: float,
                     **cuts)
     x = between[:, 0]
     lo, hi = x.min(), x.max()
-    left = between[x <= lo + config.contact_depth][:, 1:]
-    right = between[x >= hi - config.contact_depth][:, 1:]
+    on_left, on_right = x <= lo + config.contact_depth, x >= hi - config.contact_depth
+    left, right = between[on_left][:, 1:], between[on_right][:, 1:]
     (aL, eL, cL, rL), (aR, eR, cR, rR) = (_patch(q, config.patch_cell) for q in (left, right))
     c_G = np.array([(lo + hi) / 2, *(cL + cR) / 2])
     p_WC = t + R @ c_G
     force_cap = 2 * mu * N
     torque_cap = mu * N * (rL + rR)
+    # The squeeze: the pads' own push along their faces (towards the palm it only seats the
+    # object against it, so only its part out of the hand, +y_G, and across the pads, ±z_G).
+    push = np.zeros(2)
+    if normals_W is not None:
+        # Each point weighs as a compliant pad presses it: by how deep the pad reaches past it.
+        n_G = np.asarray(normals_W, float)[inside] @ R
+        depth = config.contact_depth
+        push = (squeeze_tangent(n_G[on_left], -1.0, 1.0 - (x[on_left] - lo) / depth)
+                + squeeze_tangent(n_G[on_right], 1.0, 1.0 - (hi - x[on_right]) / depth))
+        push[0] = max(push[0], 0.0)
+    squeeze_force = N * float(np.linalg.norm(push))  # [N] friction must carry it before any load
     # The loads: the patches accelerate the object by a against gravity: f = m (a − g).
     dirs = np.linspace(0.0, 2 * np.pi, 8, endpoint=False)
     accel = np.vstack([[0.0, 0.0, 0.0], [0.0, 0.0, config.lift_acceleration],
@@ -318,7 +384,8 @@ def hold(X_WG: np.ndarray, *, target_p_W: np.ndarray, mass: float,
     x_G = R[:, 0]
     f_t = np.linalg.norm(f_W - np.outer(f_W @ x_G, x_G), axis=1)  # across the pads' faces
     tau_x = np.abs(tau_W @ x_G)
-    u = np.sqrt((f_t / force_cap) ** 2 + (tau_x / max(torque_cap, 1e-12)) ** 2)
+    u = np.sqrt(((f_t + squeeze_force) / force_cap) ** 2
+                + (tau_x / max(torque_cap, 1e-12)) ** 2)
     lever = float(abs(x_G @ np.cross(r_W, [0.0, 0.0, 1.0])))
     return Hold(width=float(hi - lo), n_points=len(between), patch_area=float(min(aL, aR)),
                 patch_extent=float(min(eL, eR)), torsion_radius=float((rL + rR) / 2), p_WC=p_WC,
@@ -326,7 +393,8 @@ def hold(X_WG: np.ndarray, *, target_p_W: np.ndarray, mass: float,
                 torque_capacity=torque_cap,
                 translational_margin=float(force_cap / f_t.max()) if f_t.max() > 0 else np.inf,
                 torsional_margin=float(torque_cap / tau_x.max()) if tau_x.max() > 0 else np.inf,
-                margin=float(1.0 / u.max()) if u.max() > 0 else np.inf, **cuts)
+                margin=float(1.0 / u.max()) if u.max() > 0 else np.inf,
+                squeeze=squeeze_force / force_cap, **cuts)
 
 
 # --- (c) P(hold | features) ---------------------------------------------------------------------
@@ -406,9 +474,11 @@ def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: n
     others_p_W = np.asarray(others_p_W, float).reshape(-1, 3)
     mass = hull_volume(target_p_W) * mean_density(category, model.densities,
                                                   config.default_density)
+    normals_W = point_normals(target_p_W)
     p, reasons, holds, hits = [], [], [], []
     for X in np.asarray(X_WG, float).reshape(-1, 4, 4):
-        h = hold(X, target_p_W=target_p_W, mass=mass, config=config, approach=approach)
+        h = hold(X, target_p_W=target_p_W, mass=mass, config=config, approach=approach,
+                 normals_W=normals_W)
         c = collision(X, others_p_W=others_p_W, table_z=table_z, approach=approach,
                       config=config, closed_width=h.width if h.n_points else None)
         holds.append(h)
@@ -422,6 +492,12 @@ def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: n
             continue
         if h.n_points < 2:
             reasons.append("nothing between the pads")
+            p.append(0.0)
+            continue
+        if h.squeeze >= 1.0:  # the contact force outside the friction cone: no weight holds
+            lean, cone = np.degrees(np.arctan([h.squeeze * config.friction, config.friction]))
+            reasons.append(f"would not hold: the grip squeezes it out (its surface under the "
+                           f"pads leans {lean:.0f}° from their push; friction holds {cone:.0f}°)")
             p.append(0.0)
             continue
         ph = float(model.predict_proba(h.features())[0])
@@ -479,4 +555,5 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
     return GraspCandidates(X_WG[order], parts[order], p_part[order], p_local[order],
                            score[order], candidates.target, p_hold=f.p_hold[order],
                            feasibility_reasons=tuple(f.reasons[j] for j in order),
-                           source=source[order], unholdable_parts=unholdable)
+                           source=source[order], unholdable_parts=unholdable,
+                           holds=tuple(f.holds[j] for j in order))
