@@ -39,29 +39,51 @@ from tg_drake.grasping.feasibility import (
     hold_feature_vector,
     hull_volume,
 )
-from tg_drake.objects import load_library, mesh
+from tg_drake.objects import add_library, load_library, mesh
 from tg_drake.simulation.episode import TABLE_TOP_Z, EpisodeConfig, run_grasp_batch
-
-# Until objset's split (scenarios/suites/split.yaml) lands: the shipped `*_04` objects are held out.
-HELD_OUT_SUFFIX = "_04"
 
 
 def split_ids(ids) -> tuple[list[str], list[str]]:
-    """(train, held_out) object ids: the split of tg_drake.evaluation.split when it exists, else
-    the shipped library with the `*_04` objects held out (the split's initial content)."""
-    try:
-        from tg_drake.evaluation.split import load_split
-        split = load_split()
-        train = [i for i in ids if i in set(split.train)]
-        held = [i for i in ids if i in set(split.held_out)]
-        return train, held
-    except ImportError:
-        held = [i for i in ids if i.endswith(HELD_OUT_SUFFIX)]
-        return [i for i in ids if i not in held], held
+    """(train, held_out) object ids on the split (scenarios/suites/split.yaml; a scan-like
+    version is on its original's side); ids of no set are left out."""
+    from tg_drake.errors import ScenarioError
+    from tg_drake.evaluation.split import load_split
+    split = load_split()
+    train, held = [], []
+    for i in ids:
+        try:
+            (train if split.role(i) == "train" else held).append(i)
+        except ScenarioError:
+            continue
+    return train, held
+
+
+def libraries(paths) -> dict:
+    """Object id → LibraryObject over the shipped library and the `--library` folders given
+    (registered, so that perception finds their objects too)."""
+    objects = dict(load_library())
+    for path in paths or ():
+        objects.update(load_library(path))
+        add_library(path)
+    return objects
+
+
+def perceived_cloud(obj, pose: str, seed: int) -> np.ndarray:
+    """The completed cloud the feasibility stage sees of `obj` at its resting pose (yaw 0, the
+    episode's frame): ray cast from the default camera, through the evaluation's depth sensor
+    model (the D415), put through perception."""
+    from tg_drake.evaluation.jobs import EVALUATION_SENSOR
+    from tg_drake.perception.render import perceive
+    return perceive(obj.id, pose, 0.0, sensor=EVALUATION_SENSOR, seed=seed).p_W
 
 
 def collect(args) -> int:
-    lib = load_library()
+    lib = libraries(args.library)
+    if args.only:
+        unknown = sorted(set(args.only) - set(lib))
+        if unknown:
+            raise SystemExit(f"--only: no such object {', '.join(unknown)} in the libraries")
+        lib = {i: lib[i] for i in args.only}
     rng = np.random.default_rng(args.seed)
     jobs = []
     for obj, pose in library_scenes(lib.values()):
@@ -94,20 +116,28 @@ def main(argv=None) -> int:
     c.add_argument("--per-scene", type=int, default=16, help="grasps per (object, pose)")
     c.add_argument("--seed", type=int, default=0)
     c.add_argument("--workers", type=int, default=1)
+    c.add_argument("--only", action="append", help="only this object (repeatable)")
     f = sub.add_parser("fit", help="fit the hold model on the training objects' episodes")
     f.add_argument("--episodes", type=Path, default=Path("data/hold/episodes.jsonl"))
     f.add_argument("--out", type=Path, default=Path("tg_drake/data/hold_model.json"))
     f.add_argument("--report", type=Path, help="also write the held-out report here")
+    f.add_argument("--cloud", choices=("surface", "perceived"), default="surface",
+                   help="the cloud the features are computed on: the mesh's noisy surface "
+                        "(scene_cloud), or what perception makes of it through the D415 (the "
+                        "completed cloud the stage sees at run time)")
+    for sp in (c, f):
+        sp.add_argument("--library", action="append", type=Path,
+                        help="also this library folder (repeatable; e.g. models/objects_b or a "
+                             "scan-like library in the cache)")
     args = parser.parse_args(argv)
     if args.command == "collect":
         return collect(args)
     return fit(args, argv)
 
 
-def hull_densities(ids) -> dict[str, float]:
+def hull_densities(ids, lib) -> dict[str, float]:
     """[kg/m³] per category: the median over the objects `ids` of mass / the convex-hull volume
     of their mesh (the volume perception sees)."""
-    lib = load_library()
     by_cat: dict[str, list[float]] = {}
     for oid in ids:
         obj = lib[oid]
@@ -116,13 +146,13 @@ def hull_densities(ids) -> dict[str, float]:
     return {c: float(np.median(v)) for c, v in sorted(by_cat.items())}
 
 
-def episode_features(records: list[dict], config: FeasibilityConfig, densities: dict
+def episode_features(records: list[dict], config: FeasibilityConfig, densities: dict, lib,
+                     cloud: str = "surface"
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(F, y, object ids, refused) of the episodes with a label: F (n, len(FEATURES)) the hold
-    features of each grasp on its scene's cloud, y 1 where it held, and whether the stage refuses
-    the grasp outright (the table, or nothing between the pads: it gives them 0; they are left out
-    of the fit)."""
-    lib = load_library()
+    features of each grasp on its scene's cloud (`cloud`: "surface" or "perceived"), y 1 where
+    it held, and whether the stage refuses the grasp outright (the table, or nothing between the
+    pads: it gives them 0; they are left out of the fit)."""
     by_scene: dict[tuple[str, str], list[dict]] = {}
     for r in records:
         if r.get("status") == "ok":
@@ -130,7 +160,8 @@ def episode_features(records: list[dict], config: FeasibilityConfig, densities: 
     F, y, ids, hit = [], [], [], []
     for (oid, pose), rs in sorted(by_scene.items()):
         obj = lib[oid]
-        p_W, _, _ = scene_cloud(obj, pose, seed=0)
+        p_W = (perceived_cloud(obj, pose, seed=0) if cloud == "perceived"
+               else scene_cloud(obj, pose, seed=0)[0])
         X = np.array([np.reshape(r["X_WG"], (4, 4)) for r in rs])
         f = grasp_feasibility(X, target_p_W=p_W, others_p_W=np.zeros((0, 3)),
                               table_z=TABLE_TOP_Z, approach=EpisodeConfig().approach_distance,
@@ -163,8 +194,10 @@ def scores(p: np.ndarray, y: np.ndarray, ids: np.ndarray) -> dict:
     per_object = {o: {"n": int((ids == o).sum()),
                       "accuracy": float(np.mean((p[ids == o] >= 0.5) == y[ids == o])),
                       "held": float(y[ids == o].mean())} for o in np.unique(ids)}
+    from sklearn.metrics import roc_auc_score
+    auc = float(roc_auc_score(y, p)) if 0 < y.sum() < len(y) else None
     return {"n": int(len(y)), "held": float(y.mean()),
-            "accuracy": float(np.mean((p >= 0.5) == y)),
+            "accuracy": float(np.mean((p >= 0.5) == y)), "auc": auc,
             "brier": float(np.mean((p - y) ** 2)),
             "brier_base_rate": float(np.mean((y.mean() - y) ** 2)),
             "reliability": reliability(p, y), "per_object": per_object}
@@ -174,9 +207,10 @@ def fit(args, argv) -> int:
     from sklearn.linear_model import LogisticRegression
 
     records = read_records(args.episodes)
-    train_ids, held_ids = split_ids(sorted(load_library()))
-    densities = hull_densities(train_ids)
-    F, y, ids, hit = episode_features(records, FeasibilityConfig(), densities)
+    lib = libraries(args.library)
+    train_ids, held_ids = split_ids(sorted(lib))
+    densities = hull_densities(train_ids, lib)
+    F, y, ids, hit = episode_features(records, FeasibilityConfig(), densities, lib, args.cloud)
     train_ids = [i for i in train_ids if i in set(ids)]
     held_ids = [i for i in held_ids if i in set(ids)]
     train = np.isin(ids, train_ids) & ~hit
@@ -199,7 +233,8 @@ def fit(args, argv) -> int:
     p_held = model.predict_proba(F[held])
     report = {"train": scores(p_train, y[train], ids[train]),
               "held_out": scores(p_held, y[held], ids[held])}
-    meta["fit"] = {k: {m: v[m] for m in ("n", "held", "accuracy", "brier", "brier_base_rate")}
+    meta["fit"] = {k: {m: v[m] for m in ("n", "held", "accuracy", "auc", "brier",
+                                         "brier_base_rate")}
                    for k, v in report.items()}
     args.out.write_text(json.dumps(model.as_dict(), indent=1) + "\n")
     if args.report:
