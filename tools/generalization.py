@@ -29,8 +29,11 @@ COMMAND = ("nice -n 10 tg-drake eval scenarios/suites/generalization.yaml --out 
            "python tools/make_scanlike.py --all --import --library models/objects_b\n"
            "nice -n 10 tg-drake eval scenarios/suites/generalization_scanlike.yaml --out "
            "/tmp/gen_scan\n"
+           "nice -n 10 tg-drake eval scenarios/suites/generalization_scanlike_executed.yaml "
+           "--out /tmp/gen_scan_exec\n"
            "python tools/generalization.py /tmp/gen/results.jsonl /tmp/gen_exec/results.jsonl "
-           "/tmp/gen_scan/results.jsonl --out docs/results/generalization")
+           "/tmp/gen_scan/results.jsonl /tmp/gen_scan_exec/results.jsonl "
+           "--out docs/results/generalization")
 
 
 def read_records(paths) -> list[dict]:
