@@ -29,6 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
+from tg_drake.errors import ScenarioError
+from tg_drake.evaluation.split import load_split
 from tg_drake.executor import Job, make_executor, read_records, run_jobs
 from tg_drake.grasping.dataset import SamplingConfig, library_scenes, scene_cloud, scene_grasps
 from tg_drake.grasping.feasibility import (
@@ -46,8 +48,6 @@ from tg_drake.simulation.episode import TABLE_TOP_Z, EpisodeConfig, run_grasp_ba
 def split_ids(ids) -> tuple[list[str], list[str]]:
     """(train, held_out) object ids on the split (scenarios/suites/split.yaml; a scan-like
     version is on its original's side); ids of no set are left out."""
-    from tg_drake.errors import ScenarioError
-    from tg_drake.evaluation.split import load_split
     split = load_split()
     train, held = [], []
     for i in ids:
@@ -72,6 +72,7 @@ def perceived_cloud(obj, pose: str, seed: int) -> np.ndarray:
     """The completed cloud the feasibility stage sees of `obj` at its resting pose (yaw 0, the
     episode's frame): ray cast from the default camera, through the evaluation's depth sensor
     model (the D415), put through perception."""
+    # Here, not at the top: perception's renderer (Open3D) only for `fit --cloud perceived`.
     from tg_drake.evaluation.jobs import EVALUATION_SENSOR
     from tg_drake.perception.render import perceive
     return perceive(obj.id, pose, 0.0, sensor=EVALUATION_SENSOR, seed=seed).p_W
@@ -194,7 +195,7 @@ def scores(p: np.ndarray, y: np.ndarray, ids: np.ndarray) -> dict:
     per_object = {o: {"n": int((ids == o).sum()),
                       "accuracy": float(np.mean((p[ids == o] >= 0.5) == y[ids == o])),
                       "held": float(y[ids == o].mean())} for o in np.unique(ids)}
-    from sklearn.metrics import roc_auc_score
+    from sklearn.metrics import roc_auc_score  # scikit-learn only when fitting, like `fit`
     auc = float(roc_auc_score(y, p)) if 0 < y.sum() < len(y) else None
     return {"n": int(len(y)), "held": float(y.mean()),
             "accuracy": float(np.mean((p >= 0.5) == y)), "auc": auc,

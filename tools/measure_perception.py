@@ -42,9 +42,8 @@ def _init(database: str | None, pose_calibration: str | None = None) -> None:
         import tg_drake.perception.pose as pose
         pose.CALIBRATION_FILE = Path(pose_calibration)
     if database is not None:  # every kernel prior of this process against that database
-        import tg_drake.evaluation.jobs as jobs
-        from tg_drake.kernels.database import load_database
-        jobs.load_database = lambda: load_database(database)
+        from tg_drake.evaluation.jobs import use_database
+        use_database(database)
 
 
 def _run(case) -> list[dict]:

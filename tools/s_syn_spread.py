@@ -31,7 +31,6 @@ import numpy as np
 from tg_drake.evaluation import jobs
 from tg_drake.evaluation.suite import load_suite
 from tg_drake.evaluation.tables import LOGIC_METHODS, category, per_category
-from tg_drake.kernels.database import load_database
 
 ROOT = Path(__file__).resolve().parents[1]
 SUITE = ROOT / "scenarios" / "suites" / "s_syn.yaml"
@@ -102,12 +101,10 @@ def main(argv=None) -> int:
         parser.error("--samplings must be >= 1")
     database = "the shipped tg_drake/data/kernel_db.npz"
     if args.database is not None:
-        path = Path(args.database)
-        if not path.is_file():
-            parser.error(f"--database {path}: no such file")
-        db = load_database(str(path))
-        jobs.load_database = lambda p=None: db  # every prior and floor from that file
-        database = str(path)
+        if not Path(args.database).is_file():
+            parser.error(f"--database {args.database}: no such file")
+        jobs.use_database(args.database)  # every prior and floor from that file
+        database = args.database
     _, cases = load_suite(SUITE)
     result = spread(cases, args.samplings)
     command = "python tools/s_syn_spread.py " + " ".join(

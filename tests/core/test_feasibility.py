@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from grasp_helpers import top_down
 
+from tg_drake.evaluation.split import load_split
 from tg_drake.grasping.feasibility import (
     FEATURES,
     GRAVITY,
@@ -192,7 +193,6 @@ def test_the_shipped_hold_model_was_fitted_on_training_objects_only():
     assert model.features == FEATURES
     train, held = set(model.meta["train_objects"]), set(model.meta["held_out_objects"])
     assert train and held and not train & held
-    from tg_drake.evaluation.split import load_split
     split = load_split()  # object-wise: every fitted object on the split's training side
     assert all(split.role(o) == "train" for o in train)
     assert all(split.role(o) == "held_out" for o in held)

@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tg_drake.errors import KernelError
 from tg_drake.evaluation import jobs
 from tg_drake.evaluation.suite import load_suite
 from tg_drake.evaluation.tables import category
@@ -50,3 +51,16 @@ def test_a_missing_database_file_is_a_clear_error(tool, tmp_path, capsys):
     with pytest.raises(SystemExit):
         tool.main(["--database", str(tmp_path / "none.npz"), "--out", str(tmp_path / "x")])
     assert "none.npz: no such file" in capsys.readouterr().err
+
+
+def test_another_database_file_is_used_and_a_missing_one_refused(tool, cases, tmp_path):
+    shipped = REPO / "tg_drake" / "data" / "kernel_db.npz"
+    default = tool.sampling_records(cases[:2], 0)
+    try:
+        jobs.use_database(shipped)  # the same file by its path: the same priors
+        assert [r["priors"] for r in tool.sampling_records(cases[:2], 0)] == \
+            [r["priors"] for r in default]
+        with pytest.raises(KernelError, match="no such kernel database file"):
+            jobs.use_database(tmp_path / "none.npz")
+    finally:
+        jobs.use_database(None)

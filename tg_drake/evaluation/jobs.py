@@ -20,10 +20,11 @@ from __future__ import annotations
 
 import functools
 import zlib
+from pathlib import Path
 
 import numpy as np
 
-from tg_drake.errors import RuleError, TgDrakeError
+from tg_drake.errors import KernelError, RuleError, TgDrakeError
 from tg_drake.evaluation.suite import DATASET_OF_SETTING
 from tg_drake.kernels.database import load_database
 from tg_drake.kernels.library import sample_object
@@ -74,6 +75,23 @@ CONFIDENT_PART = 0.5  # S_REAL: detected parts at least this likely are kept (as
 # render (tg_drake.perception.sensor_model; a scenario's own default is the exact render).
 EVALUATION_SENSOR = StructuredLight()
 
+# The kernel database file the evaluation's priors and floors come from (None: the shipped one);
+# a tool measuring another database sets it for its process with `use_database`.
+_DATABASE: str | None = None
+
+
+def use_database(path: str | Path | None) -> None:
+    """Every kernel prior, floor and sampling density of this process's evaluation from the
+    database file `path` (None: the shipped one again)."""
+    global _DATABASE
+    if path is not None and not Path(path).is_file():
+        raise KernelError(f"{path}: no such kernel database file")
+    _DATABASE = None if path is None else str(path)
+
+
+def _database():
+    return load_database(_DATABASE)
+
 
 @functools.cache
 def _engine(category: str, grasp: str, exclusive: bool):
@@ -102,7 +120,7 @@ def logic_answers(observations, priors: dict, truth_tasks, methods=METHODS,
     "ground_truth"), whose fitted floor the kernel database gives (`KernelDatabase.floor`), as
     the pipeline's logic uses it. An impossible observation (probability 0) is recorded as the
     error it is, with no distributions."""
-    floor = load_database().floor(clouds)
+    floor = _database().floor(clouds)
 
     def variant(models):
         return tuple(theory if m == "specific" else m for m in models[:2]) + models[2:]
@@ -135,7 +153,7 @@ def kernel_priors(points, normals, labels, *, object_id: str, t: int,
                   clouds: str = "perceived") -> dict:
     """Label fractions (T = 0) and Manifolds (T = t) priors, leave-one-object-out, against the
     database entries chosen for this kind of query cloud ("perceived" or "ground_truth")."""
-    db = load_database()
+    db = _database()
     entries, _ = db.choice(clouds)
     return {name: _round(db.prior(points, normals, labels, t=T, entries=entries,
                                   exclude_object=object_id).probabilities)
@@ -153,7 +171,7 @@ def run_synthetic(case) -> dict:
     handles = handle_count(vertices, labels) if "handle" in obj.parts else 1
     # One labelled sampling per object, whatever its pose and containment (the paper's S_SYN has
     # one point cloud per object, so its Manifolds accuracy is over objects: 36 of 41 = 87.8 %).
-    cloud = sample_object(obj, spacing=load_database().spacing,
+    cloud = sample_object(obj, spacing=_database().spacing,
                           rng=np.random.default_rng(_seed(obj.id, case.seed)))
     seen = interior_visible(obj.id, placement.pose)
     observations = Observations(parts={p: 1.0 for p in obj.parts}, pose={placement.pose: 1.0},
