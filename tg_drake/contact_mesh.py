@@ -17,8 +17,9 @@ import trimesh
 
 # [m] the largest distance allowed between the collision surface and the visual one (either way):
 # half a millimetre, a quarter of the thinnest blade the libraries hold (2 mm) and under the depth
-# sensor's noise at the table (the D415 model's 1-2 mm), so neither a grasp nor a resting pose
-# moves by more than the camera can tell.
+# sensor's error at the table (the D415 model: z²·0.08 px / (f·b), about 2 mm RMS at 1 m, output in
+# 1 mm steps), so neither a grasp nor a resting pose moves by more than the camera can tell.
+# Measured with it: docs/design.md, "Simulation settings".
 CONTACT_TOLERANCE = 0.5e-3
 SAMPLES = 20_000  # surface points per side of the two-sided distance estimate (seeded).
 MIN_TRIANGLES = 16  # the decimation's search starts here.
