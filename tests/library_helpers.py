@@ -20,9 +20,6 @@ def copy_object(src_id: str, new_id: str, out_dir: Path, *, derived: bool = True
     folder = out_dir / new_id
     folder.mkdir(parents=True, exist_ok=True)
     (folder / f"{new_id}.obj").write_text(src.mesh_path.read_text())
-    collision = src.directory / f"{src_id}_collision.obj"
-    if collision.is_file():  # a generated object's collision mesh, which its SDF names
-        (folder / f"{new_id}_collision.obj").write_text(collision.read_text())
     np.save(folder / f"{new_id}_parts.npy", np.load(src.parts_path))
     (folder / f"{new_id}.sdf").write_text(src.sdf_path.read_text().replace(src_id, new_id))
     if derived:

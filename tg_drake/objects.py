@@ -1,11 +1,8 @@
 """The object library: generated household objects of the paper's 11 categories, four or more each.
 
-Files live in the `tg_drake_models` package (``models/objects/<id>/``): ``<id>.obj`` (the mesh:
-closed, outward-oriented triangles; the visual, and what perception and the part labels use),
-``<id>_collision.obj`` (the same surface with fewer triangles, within 0.5 mm:
-tg_drake.contact_mesh),
-``<id>.sdf`` (one model and one body with mass properties from the mesh volume and material
-densities, its collision the rigid-hydroelastic ``<id>_collision.obj``),
+Files live in the `tg_drake_models` package (``models/objects/<id>/``): ``<id>.obj`` (the visual and
+collision mesh: closed, outward-oriented triangles), ``<id>.sdf`` (one model and one body with
+mass properties from the mesh volume and material densities, rigid-hydroelastic collision),
 ``<id>_parts.npy`` (uint8 part label per mesh vertex, an index into PART_LABELS) and one
 ``library.yaml`` describing every object. They are written by ``tools/make_objects.py``.
 

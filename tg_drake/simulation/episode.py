@@ -67,7 +67,7 @@ CARRIER_JOINTS = ("carrier_x", "carrier_y", "carrier_z", "carrier_rx", "carrier_
 class EpisodeConfig:
     """The physics and the script of one grasp episode."""
 
-    time_step: float = 0.005  # discrete plant step [s] (the scenario's default: docs/design.md).
+    time_step: float = 0.005  # discrete plant step [s] (2–10 ms held a grasp: docs/design.md).
     approach_distance: float = 0.05  # start this far back along −y_G [m].
     approach_time: float = 0.15  # [s]
     close_time: float = 0.3  # [s]
