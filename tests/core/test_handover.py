@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from tg_drake.errors import ScenarioError
+from tg_drake.grasping.feasibility import grip_width
 from tg_drake.logic.receive import receiver_parts
 from tg_drake.planning.handover import (
     Handover,
@@ -99,6 +100,26 @@ def test_a_receiver_approaching_only_from_its_side_refuses_top_grasps():
     assert grasp is None and "within 45°" in why
 
 
+def test_the_robots_gripper_points_fill_the_band_its_pads_open_through():
+    # Holding the 25 mm bar, the pads' inner faces are ±12.5 mm from the grasp point (along y_W
+    # here); they open to ±55 mm. A receiver's pad placed between (y 30 mm, at the grasp point)
+    # would be struck as the robot opens: the band is filled only given the grip width.
+    probe = np.array([0.0, 0.03, 0.3])
+    open_only = robot_gripper_points(top_grasp(0.0, 0.3), retreat=0.1)
+    holding = robot_gripper_points(top_grasp(0.0, 0.3), retreat=0.1, closed_width=0.025)
+    assert np.linalg.norm(open_only - probe, axis=1).min() > 0.02
+    assert np.linalg.norm(holding - probe, axis=1).min() <= 0.005
+    # Nothing of the band lies between the holding pads, where the object is.
+    inner = holding[(np.abs(holding[:, 1]) < 0.0125 - 1e-9) & (np.abs(holding[:, 2] - 0.3) < 0.04)]
+    assert len(inner) == 0
+
+
+def test_the_grip_width_is_the_span_of_the_points_between_the_pads():
+    target = bar(0.3)  # its points 4 mm apart across its 25 mm: −12.5 … +11.5 mm
+    assert grip_width(top_grasp(0.07, 0.3), target.p_W, 0.11) == pytest.approx(0.024, abs=1e-9)
+    assert grip_width(top_grasp(0.5, 0.3), target.p_W, 0.11) == 0.0  # past its end
+
+
 def test_the_robots_gripper_points_fill_its_housing_and_open_pads_swept_back():
     p = robot_gripper_points(top_grasp(0.0, 0.3), retreat=0.1)
     # The housing is 146 mm along the closing axis (y_W here); the pads open to 110 mm, their
@@ -186,6 +207,10 @@ def test_judge_pass_success_is_the_receivers_steady_hold_alone():
     assert ok.task == "pass" and ok.success, ok
     assert ok.measure["height_change_m"] == pytest.approx(0.0008)
     assert ok.measure["receiver_held"] is True
+    # The check's time is a sum of the plan's segment times: a hold of exactly the duration,
+    # measured a rounding short of it, is the whole hold (a run measured 1 s − 2e-15 s).
+    assert judged(held_for=1.0 - 2e-15).success
+    assert not judged(held_for=1.0 - 1e-3).success
 
 
 @pytest.mark.parametrize("change, words", [

@@ -28,7 +28,8 @@ hand-over pose, each also turned ±90° about its pads' width axis (`turned_abou
 sides the table closed); those whose approach is within `max_approach_angle` of the receiver's
 direction and within its reach are checked by the feasibility core
 (`tg_drake.grasping.feasibility.grasp_feasibility`): clear of the robot's gripper — its housing
-and its pads open, swept back along the robot's retreat —, of the robot arm's links where the arm
+and its pads open, swept back along the robot's retreat, and the band its pads pass through from
+holding the object to open —, of the robot arm's links where the arm
 stands at the hand-over (the planner's IK) and of the table, with something between the pads.
 Chosen: the best P(part) · P(grasp | local shape) · P(hold) among those whose contact mechanics
 carry the weight (combined margin ≥ 1), else among all.
@@ -54,7 +55,9 @@ from tg_drake.errors import ScenarioError
 from tg_drake.grasping.feasibility import (
     GRASP_DEPTH,
     FeasibilityConfig,
+    closing_sweep,
     grasp_feasibility,
+    grip_width,
     gripper_boxes,
 )
 from tg_drake.robot import IIWA_JOINTS, WSG_GRASP_POINT_G, WSG_MAX_OPENING, WSG_PAD_SIZE, X_7G_XYZ
@@ -295,22 +298,34 @@ def handover_object_poses(handover: "Handover", X_WO: np.ndarray, X_WG: np.ndarr
     return poses
 
 
-def robot_gripper_points(X_WG: np.ndarray, *, retreat: float, spacing: float = 0.005
-                         ) -> np.ndarray:
-    """(N, 3) world points on the surfaces of the robot's WSG at X_WG with its pads open (as
-    they open at the release) and swept `retreat` [m] back along −y_G (its retreat): what the
-    receiver's gripper must stay clear of, `spacing` [m] apart (about perception's voxel). (A box
-    of the receiver's that cuts one of these boxes contains some of its surface: the inside adds
-    nothing but cost.)"""
+def robot_gripper_points(X_WG: np.ndarray, *, retreat: float, closed_width: float | None = None,
+                         spacing: float = 0.005) -> np.ndarray:
+    """(N, 3) world points of the robot's WSG at X_WG that the receiver's gripper must stay
+    clear of, `spacing` [m] apart (about perception's voxel): the surfaces of its housing and of
+    its pads open (as they open at the release) swept `retreat` [m] back along −y_G (its
+    retreat) — a box of the receiver's that cuts one of these contains some of its surface —,
+    and, given the robot's grip width `closed_width` [m], the whole volume its pads pass through
+    from holding (that width apart) to open: the receiver closes while the robot still holds,
+    and the robot opens with the receiver's fingers in place, so a receiver's pad may lie
+    wholly inside that band."""
     out = []
     for _, centre, half in gripper_boxes(WSG_MAX_OPENING, retreat):
-        axes = [np.linspace(c - h, c + h, max(2, int(np.ceil(2 * h / spacing)) + 1))
-                for c, h in zip(centre, half, strict=True)]
-        grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-        on_face = np.any(np.isclose(np.abs(grid - centre), half, rtol=0, atol=1e-9), axis=1)
-        out.append(grid[on_face])
+        grid = _box_grid(centre, half, spacing)
+        out.append(grid[np.any(np.isclose(np.abs(grid - centre), half, rtol=0, atol=1e-9),
+                               axis=1)])
+    if closed_width is not None:
+        out += [_box_grid(centre, half, spacing)
+                for _, centre, half in closing_sweep(WSG_MAX_OPENING, closed_width)]
     p_G = np.concatenate(out)
     return p_G @ np.asarray(X_WG, float)[:3, :3].T + np.asarray(X_WG, float)[:3, 3]
+
+
+def _box_grid(centre: np.ndarray, half: np.ndarray, spacing: float) -> np.ndarray:
+    """(N, 3) a grid filling the box (centre, half sizes) at most `spacing` [m] apart, its faces
+    included."""
+    axes = [np.linspace(c - h, c + h, max(2, int(np.ceil(2 * h / spacing)) + 1))
+            for c, h in zip(centre, half, strict=True)]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
 
 
 @dataclass(frozen=True)
@@ -384,7 +399,9 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
            keep.tobytes(), hashlib.sha1(arm_O.tobytes()).hexdigest())
     if cache is None or key not in cache:
         target_p_W = (np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3])
-        robot = np.concatenate([robot_gripper_points(X_WG_robot, retreat=retreat), arm])
+        grip = grip_width(X_WG_robot, target_p_W, WSG_MAX_OPENING)
+        robot = np.concatenate([robot_gripper_points(X_WG_robot, retreat=retreat,
+                                                     closed_width=grip), arm])
         f = grasp_feasibility(X_WR[keep], target_p_W=target_p_W, others_p_W=robot,
                               table_z=table_z, approach=config.approach, category=category,
                               config=feasibility)
