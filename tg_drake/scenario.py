@@ -395,7 +395,9 @@ class PipelineConfig:
 @dataclass
 class Scenario:
     random_seed: int = 0
-    simulation_duration: float = 20.0  # upper bound on simulated time for one run [s]
+    simulation_duration: float = 40.0  # [s] upper bound on simulated time for one run: a guard
+    # against a run that never finishes, above any plan's length (20 s cut 3 of 177 executed
+    # S_GRASP/S_ROBOT runs mid-plan: a pass's plan runs 23.7 s; the longest finished run 20.0 s)
     simulator_config: SimulatorConfig = field(default_factory=lambda: SimulatorConfig(
         max_step_size=0.01, use_error_control=False, target_realtime_rate=0.0,
         publish_every_time_step=False))
