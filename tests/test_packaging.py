@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib.metadata
 import importlib.util
 import os
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -77,9 +78,15 @@ def wheel(tmp_path_factory) -> Path:
         pytest.skip("building the wheel offline needs setuptools>=77 in this environment "
                     "(the `test` extra: make setup)")
     out = tmp_path_factory.mktemp("wheel")
+    # Built from a copy without the checkout's build/ (setuptools copies into build/lib and never
+    # removes what is there: a file deleted from the source since an earlier build would ride
+    # along) nor its environment and caches.
+    source = tmp_path_factory.mktemp("source") / "tg_drake"
+    shutil.copytree(REPO, source, ignore=shutil.ignore_patterns(
+        "build", ".venv", ".git", "*.egg-info", "__pycache__", ".*_cache"))
     build = subprocess.run(
         [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "--no-index",
-         "-q", "-w", str(out), str(REPO)], capture_output=True, text=True)
+         "-q", "-w", str(out), str(source)], capture_output=True, text=True)
     assert build.returncode == 0, build.stdout + build.stderr
     (path,) = out.glob("tg_drake-*.whl")
     return path
