@@ -1,9 +1,12 @@
 """The pass on arrays: the receiver's mount and hand-over geometry, its grasp chosen clear of the
 robot's gripper, the part the logic names for it, and the judge of its hold."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
+import tg_drake.planning.handover as handover_module
 from tg_drake.errors import ScenarioError
 from tg_drake.grasping.feasibility import grip_width
 from tg_drake.logic.receive import receiver_parts
@@ -85,6 +88,34 @@ def test_no_receiver_grasp_clear_of_the_robots_fingers_is_said_so():
     grasp, why = choose([0.06, 0.08], parts={"usable_area": 1.0})
     assert grasp is None
     assert "clear of the robot's gripper" in why and "other object" in why
+
+
+def test_a_receiver_grasp_that_would_push_the_held_object_is_refused(monkeypatch):
+    # The grasp point 35 mm under the bar's axis: the housing's face (39.9 mm above the grasp
+    # point) reaches 7.6 mm into the 25 mm bar, which hangs in the robot's grip. (Its axis z_O
+    # along the bar, x_W: the receiver's grasps keep their height.)
+    target = bar(0.3)
+    X_WO = target.X_WO.copy()
+    X_WO[:3, :3] = np.column_stack([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+    target = dataclasses.replace(target, X_WO=X_WO)
+    deep = GraspCandidates(X_WG=np.array([top_grasp(-0.07, 0.265)]),
+                           parts=np.array([PART_LABELS.index("handle")]), p_part=np.ones(1),
+                           p_local=np.full(1, 0.5), score=np.full(1, 0.5))
+
+    def receive():
+        return choose_receiver_grasp(
+            deep, target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
+            X_WG_robot=top_grasp(0.07, 0.3), receiver_parts={"handle": 1.0},
+            handover=HANDOVER, table_z=0.0, retreat=0.1)
+
+    # Turned about its pads' width axis it comes in from the side, its housing clear: taken so.
+    grasp, why = receive()
+    assert grasp is not None and abs(grasp.X_WR[2, 1]) < 1e-9, why
+    # Not turned, nothing is left.
+    monkeypatch.setattr(handover_module, "TURNS", ())
+    grasp, why = receive()
+    assert grasp is None
+    assert "would push the object in the robot's grip" in why and "housing" in why
 
 
 def test_a_receiver_that_cannot_reach_is_said_so():

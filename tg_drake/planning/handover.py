@@ -30,7 +30,9 @@ direction and within its reach are checked by the feasibility core
 (`tg_drake.grasping.feasibility.grasp_feasibility`): clear of the robot's gripper — its housing
 and its pads open, swept back along the robot's retreat, and the band its pads pass through from
 holding the object to open —, of the robot arm's links where the arm
-stands at the hand-over (the planner's IK) and of the table, with something between the pads.
+stands at the hand-over (the planner's IK) and of the table, with something between the pads, and
+its housing and open pads clear of the object on the approach (`_pushes`: held by the robot, the
+object would be pushed round in its grip).
 Chosen: the best P(part) · P(grasp | local shape) · P(hold) among those whose contact mechanics
 carry the weight (combined margin ≥ 1), else among all.
 
@@ -409,11 +411,17 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
             cache[key] = f
     else:
         f = cache[key]
-    ok = np.array([not r for r in f.reasons], bool)
+    # The object hangs in the robot's grip: a receiver whose housing or open pads, coming in
+    # along its approach, cut it would push it round in that grip (a gripper on an object on
+    # the table may push it onto the table: the hold model weighs that there, not here).
+    reasons = [r or _pushes(h, feasibility.point_tolerance) for r, h in zip(f.reasons, f.holds,
+                                                                            strict=True)]
+    ok = np.array([not r for r in reasons], bool)
     if not ok.any():
-        first = next((r for r in f.reasons if r), "")
+        first = next((r for r in reasons if r), "")
         return None, (f"hand-over: no receiver grasp on {wanted} clear of the robot's gripper, "
-                      f"its arm and the table ({len(keep)} tried; first: {first})")
+                      f"its arm and the table, and of the object ({len(keep)} tried; first: "
+                      f"{first})")
     idx = on_part[keep]
     p_local = np.asarray(candidates.p_local, float)[idx]
     score = np.where(ok, p_recv[idx] * p_local * f.p_hold, -1.0)
@@ -424,6 +432,17 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     return ReceiverGrasp(X_WR[keep][best], names[i], i, float(p_recv[i]), float(p_local[best]),
                          float(f.p_hold[best]), float(score[best]),
                          float(f.holds[best].margin)), ""
+
+
+def _pushes(h, tolerance: float) -> str:
+    """Why a receiver's grasp would push the object held by the robot (its housing or its open
+    pads, swept along the approach, cut by the object's points more than `tolerance` [m]), or
+    ""."""
+    box, depth = max((("housing", h.housing_cut), ("pads", h.pad_cut)), key=lambda b: b[1])
+    if depth <= tolerance:
+        return ""
+    return (f"would push the object in the robot's grip: the receiver's {box} cut it by "
+            f"{depth * 1000:.1f} mm on the approach")
 
 
 # [fraction] of the observed points left out at each end of the object's axis when its observed
