@@ -118,6 +118,22 @@ def test_a_receiver_grasp_that_would_push_the_held_object_is_refused(monkeypatch
     assert "would push the object in the robot's grip" in why and "housing" in why
 
 
+def test_the_receiver_keeps_its_clearance_from_the_robots_gripper():
+    # The robot's housing spans x 0.045 … 0.095 m (its grasp at x 0.07, the housing 50 mm along
+    # the pads' width, x_W here); a receiver's at x 0.018 m ends at 0.043 m: 2 mm from it.
+    target = bar(0.3)
+
+    def receive(clearance):
+        return choose_receiver_grasp(
+            candidates([0.018]), target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
+            X_WG_robot=top_grasp(0.07, 0.3), receiver_parts={"usable_area": 1.0},
+            handover=HANDOVER, table_z=0.0, retreat=0.1, clearance=clearance)
+
+    assert receive(0.0)[0] is not None
+    grasp, why = receive(0.003)
+    assert grasp is None and "clear of the robot's gripper" in why
+
+
 def test_a_receiver_that_cannot_reach_is_said_so():
     short = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=180.0, reach=0.3), np.eye(4))
     grasp, why = choose([-0.07], handover=short)
@@ -156,6 +172,8 @@ def test_the_robots_gripper_points_fill_its_housing_and_open_pads_swept_back():
     # The housing is 146 mm along the closing axis (y_W here); the pads open to 110 mm, their
     # outer faces at ±(0.055 + 0.012) m, within it.
     assert np.abs(p[:, 1]).max() == pytest.approx(0.073, abs=1e-6)
+    grown = robot_gripper_points(top_grasp(0.0, 0.3), retreat=0.1, grow=0.005)
+    assert np.abs(grown[:, 1]).max() == pytest.approx(0.078, abs=1e-6)
     below = p[p[:, 2] < 0.3 + GRASP_DEPTH - 0.0151]  # under the housing: the pads only
     assert np.abs(below[:, 1]).max() == pytest.approx(0.067, abs=1e-6)
     # The retreat sweeps it 0.1 m up (−y_G = +z_W); the fingertips reach the grasp point's

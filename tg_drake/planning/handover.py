@@ -27,14 +27,14 @@ the completed cloud, whose ends may lie past the object's), carried with the obj
 hand-over pose, each also turned ±90° about its pads' width axis (`turned_about_width`: from the
 sides the table closed); those whose approach is within `max_approach_angle` of the receiver's
 direction and within its reach are checked by the feasibility core
-(`tg_drake.grasping.feasibility.grasp_feasibility`): clear of the robot's gripper — its housing
-and its pads open, swept back along the robot's retreat, and the band its pads pass through from
-holding the object to open —, of the robot arm's links where the arm
-stands at the hand-over (the planner's IK) and of the table, with something between the pads, and
-its housing and open pads clear of the object on the approach (`_pushes`: held by the robot, the
-object would be pushed round in its grip).
-Chosen: the best P(part) · P(grasp | local shape) · P(hold) among those whose contact mechanics
-carry the weight (combined margin ≥ 1), else among all.
+(`tg_drake.grasping.feasibility.grasp_feasibility`): clear of the robot's gripper by `clearance`
+(the planner's clearance near the target) — its housing and its pads open, swept back along the
+robot's retreat, and the band its pads pass through from holding the object to open —, of the robot
+arm's links where the arm stands at the hand-over (the planner's IK) and of the table, with
+something between the pads, and its housing and open pads clear of the object on the approach
+(`_pushes`: held by the robot, the object would be pushed round in its grip). Chosen: the best
+P(part) · P(grasp | local shape) · P(hold) among those whose contact mechanics carry the weight
+(combined margin ≥ 1), else among all.
 
 The receiver's motion (`receiver_motion`, mount joint space, smooth in time): once the robot has
 arrived, from where it waits to its pre-grasp (`approach` back along +y_R from the grasp), a
@@ -301,7 +301,7 @@ def handover_object_poses(handover: "Handover", X_WO: np.ndarray, X_WG: np.ndarr
 
 
 def robot_gripper_points(X_WG: np.ndarray, *, retreat: float, closed_width: float | None = None,
-                         spacing: float = 0.005) -> np.ndarray:
+                         grow: float = 0.0, spacing: float = 0.005) -> np.ndarray:
     """(N, 3) world points of the robot's WSG at X_WG that the receiver's gripper must stay
     clear of, `spacing` [m] apart (about perception's voxel): the surfaces of its housing and of
     its pads open (as they open at the release) swept `retreat` [m] back along −y_G (its
@@ -309,14 +309,14 @@ def robot_gripper_points(X_WG: np.ndarray, *, retreat: float, closed_width: floa
     and, given the robot's grip width `closed_width` [m], the whole volume its pads pass through
     from holding (that width apart) to open: the receiver closes while the robot still holds,
     and the robot opens with the receiver's fingers in place, so a receiver's pad may lie
-    wholly inside that band."""
+    wholly inside that band. Every box grown by `grow` [m] on each side (a clearance)."""
     out = []
     for _, centre, half in gripper_boxes(WSG_MAX_OPENING, retreat):
-        grid = _box_grid(centre, half, spacing)
-        out.append(grid[np.any(np.isclose(np.abs(grid - centre), half, rtol=0, atol=1e-9),
-                               axis=1)])
+        grid = _box_grid(centre, half + grow, spacing)
+        out.append(grid[np.any(np.isclose(np.abs(grid - centre), half + grow, rtol=0,
+                                          atol=1e-9), axis=1)])
     if closed_width is not None:
-        out += [_box_grid(centre, half, spacing)
+        out += [_box_grid(centre, half + grow, spacing)
                 for _, centre, half in closing_sweep(WSG_MAX_OPENING, closed_width)]
     p_G = np.concatenate(out)
     return p_G @ np.asarray(X_WG, float)[:3, :3].T + np.asarray(X_WG, float)[:3, 3]
@@ -347,7 +347,8 @@ class ReceiverGrasp:
 def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescription,
                           X_WO: np.ndarray, X_WO_handover: np.ndarray, X_WG_robot: np.ndarray,
                           receiver_parts: dict, handover: Handover, table_z: float,
-                          retreat: float, feasibility: FeasibilityConfig | None = None,
+                          retreat: float, clearance: float = 0.0,
+                          feasibility: FeasibilityConfig | None = None,
                           category: dict | None = None, cache: dict | None = None,
                           arm_p_W: np.ndarray | None = None
                           ) -> tuple[ReceiverGrasp | None, str]:
@@ -360,7 +361,10 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     poses relative to the object and the robot's gripper does not change when the three are
     turned together about the vertical (the planner's place yaws), so it is computed once per
     robot grasp and set of poses. `arm_p_W`: (N, 3) points on the robot arm's links at the
-    hand-over (`tg_drake.planning.ik.arm_surface_points`), kept clear of as its gripper is."""
+    hand-over (`tg_drake.planning.ik.arm_surface_points`), kept clear of as its gripper is.
+    `clearance` [m]: how far the receiver's gripper stays from the robot's (the planner's
+    clearance near the target); the robot's gripper is exact geometry, so the feasibility's
+    tolerance for perceived points (`point_tolerance`) is added to it rather than allowed."""
     config = handover.config
     feasibility = feasibility or FeasibilityConfig()
     parts = np.asarray(candidates.parts, int)
@@ -397,13 +401,14 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     arm = np.zeros((0, 3)) if arm_p_W is None else np.asarray(arm_p_W, float).reshape(-1, 3)
     X_OW = np.linalg.inv(np.asarray(X_WO_handover, float))
     arm_O = np.round(arm @ X_OW[:3, :3].T + X_OW[:3, 3], 3)  # the arm as seen from the object
-    key = (np.round(X_OG, 6).tobytes(), round(float(X_WO_handover[2, 3]) - table_z, 6),
+    key = (np.round(X_OG, 6).tobytes(), round(float(X_WO_handover[2, 3]) - table_z, 6), clearance,
            keep.tobytes(), hashlib.sha1(arm_O.tobytes()).hexdigest())
     if cache is None or key not in cache:
         target_p_W = (np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3])
         grip = grip_width(X_WG_robot, target_p_W, WSG_MAX_OPENING)
-        robot = np.concatenate([robot_gripper_points(X_WG_robot, retreat=retreat,
-                                                     closed_width=grip), arm])
+        robot = np.concatenate([robot_gripper_points(
+            X_WG_robot, retreat=retreat, closed_width=grip,
+            grow=clearance + feasibility.point_tolerance), arm])
         f = grasp_feasibility(X_WR[keep], target_p_W=target_p_W, others_p_W=robot,
                               table_z=table_z, approach=config.approach, category=category,
                               config=feasibility)
