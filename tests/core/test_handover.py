@@ -124,13 +124,23 @@ def test_the_receiver_keeps_its_clearance_from_the_robots_gripper():
     target = bar(0.3)
 
     def receive(clearance):
+        handover = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=180.0,
+                                           clearance=clearance), np.eye(4))
         return choose_receiver_grasp(
             candidates([0.018]), target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
             X_WG_robot=top_grasp(0.07, 0.3), receiver_parts={"usable_area": 1.0},
-            handover=HANDOVER, table_z=0.0, retreat=0.1, clearance=clearance)
+            handover=handover, table_z=0.0, retreat=0.1)
 
     assert receive(0.0)[0] is not None
     grasp, why = receive(0.003)
+    assert grasp is None and "clear of the robot's gripper" in why
+    # 1 mm into the robot's housing: refused at no clearance too (its geometry is exact: the
+    # perceived points' 2 mm tolerance does not apply).
+    handover = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=180.0), np.eye(4))
+    grasp, why = choose_receiver_grasp(
+        candidates([0.021]), target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
+        X_WG_robot=top_grasp(0.07, 0.3), receiver_parts={"usable_area": 1.0},
+        handover=handover, table_z=0.0, retreat=0.1)
     assert grasp is None and "clear of the robot's gripper" in why
 
 

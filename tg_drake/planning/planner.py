@@ -1128,8 +1128,7 @@ def _receiving(handover: Handover, candidates: GraspCandidates, target: ObjectDe
     grasp, why = choose_receiver_grasp(
         candidates, target=target, X_WO=X_WO, X_WO_handover=X_WO_handover,
         X_WG_robot=key.X["place"].GetAsMatrix4(), receiver_parts=parts, handover=handover,
-        table_z=table_z, retreat=config.retreat_distance,
-        clearance=config.contact_min_distance, cache=cache, arm_p_W=arm_p_W)
+        table_z=table_z, retreat=config.retreat_distance, cache=cache, arm_p_W=arm_p_W)
     if grasp is None:
         return None, why
     hold = handover.config.hold_duration
