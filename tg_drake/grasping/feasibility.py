@@ -334,23 +334,23 @@ def _patch(q: np.ndarray, cell: float) -> tuple[float, float, np.ndarray, float]
     return len(cells) * cell ** 2, extent, centre, max(radius, 0.38 * cell)
 
 
-def between_pads(X_WG: np.ndarray, p_W: np.ndarray, opening: float) -> np.ndarray:
-    """(n,) bool: which points p_W (n, 3) lie between the pads of a gripper at X_WG opened
-    `opening` [m] (within the pads' length along y_G and their width along z_G)."""
+def between_pads(X_WG: np.ndarray, p_W: np.ndarray, opening: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """(inside (n,) bool, p_G (n, 3)): the points p_W (n, 3) in the gripper frame at X_WG, and
+    which of them lie between its pads opened `opening` [m] (within the pads' length along y_G
+    and their width along z_G)."""
     p_G = (np.asarray(p_W, float).reshape(-1, 3) - X_WG[:3, 3]) @ X_WG[:3, :3]
     y0, y1 = WSG_GRASP_POINT_G[1] - WSG_PAD_SIZE[1] / 2, WSG_GRASP_POINT_G[1] + WSG_PAD_SIZE[1] / 2
-    return ((p_G[:, 1] >= y0) & (p_G[:, 1] <= y1) & (np.abs(p_G[:, 2]) <= WSG_PAD_SIZE[2] / 2)
-            & (np.abs(p_G[:, 0]) <= opening / 2))
+    inside = ((p_G[:, 1] >= y0) & (p_G[:, 1] <= y1) & (np.abs(p_G[:, 2]) <= WSG_PAD_SIZE[2] / 2)
+              & (np.abs(p_G[:, 0]) <= opening / 2))
+    return inside, p_G
 
 
 def grip_width(X_WG: np.ndarray, p_W: np.ndarray, opening: float) -> float:
     """[m] how wide the points between the pads (`between_pads`) are along the closing axis
     x_G: where the pads stop as they close on them (0 when fewer than two points)."""
-    inside = between_pads(X_WG, p_W, opening)
-    if inside.sum() < 2:
-        return 0.0
-    x = ((np.asarray(p_W, float).reshape(-1, 3)[inside] - X_WG[:3, 3]) @ X_WG[:3, 0])
-    return float(x.max() - x.min())
+    inside, p_G = between_pads(X_WG, p_W, opening)
+    return float(np.ptp(p_G[inside, 0])) if inside.sum() >= 2 else 0.0
 
 
 def hold(X_WG: np.ndarray, *, target_p_W: np.ndarray, mass: float,
@@ -364,8 +364,8 @@ def hold(X_WG: np.ndarray, *, target_p_W: np.ndarray, mass: float,
     p_W = np.asarray(target_p_W, float)
     com = p_W.mean(axis=0) if p_WCoM is None and len(p_W) else np.asarray(p_WCoM, float)
     R, t = X_WG[:3, :3], X_WG[:3, 3]
-    inside = between_pads(X_WG, p_W, config.opening)
-    between = ((p_W - t) @ R)[inside]
+    inside, p_G = between_pads(X_WG, p_W, config.opening)
+    between = p_G[inside]
     N = min(config.grip_force, WSG_FORCE_LIMIT)
     mu = config.friction
     cut = penetration(X_WG, p_W, gripper_boxes(config.opening, approach), config.min_points)
