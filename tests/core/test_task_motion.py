@@ -141,6 +141,29 @@ def test_a_pour_puts_the_opening_over_the_bowl_and_tilts_it_there():
                       tilt=1.9, clearance=0.05) == []
 
 
+@pytest.mark.parametrize("tilt_deg", [110.0, 135.0, 150.0])
+def test_a_tilted_pour_is_lowered_to_pour_from_just_above_the_bowl(tilt_deg):
+    from tg_drake.planning.task_motion import box_bottom, pour_poses
+
+    X_WO = np.eye(4)
+    X_WO[:3, 3] = [0.75, 0.0, 0.05]
+    X_WG = np.eye(4)
+    X_WG[:3, :3] = R_SIDE
+    extents, bowl_xy, bowl_top = [0.08, 0.08, 0.1], (0.7, -0.25), 0.06
+    kept = pour_poses(X_WO, extents, X_WG, bowl_xy=bowl_xy, bowl_top=bowl_top,
+                      tilt=np.deg2rad(tilt_deg), clearance=0.05)
+    lowered = pour_poses(X_WO, extents, X_WG, bowl_xy=bowl_xy, bowl_top=bowl_top,
+                         tilt=np.deg2rad(tilt_deg), clearance=0.05, drop=0.03)
+    for (X_pour, X_kept), (X_pour2, X_tilted) in zip(kept, lowered):
+        assert np.allclose(X_pour, X_pour2)  # the upright pose above the bowl is the same
+        assert np.isclose(box_bottom(X_tilted, extents), bowl_top + 0.03)
+        assert np.allclose(X_tilted[:3, :3], X_kept[:3, :3])  # turned alike, only moved down
+        assert np.allclose(X_tilted[:2, 3], X_kept[:2, 3])
+        # Tilted past level, the opening's edge (the lowest corner) falls 0.03 m to the rim's
+        # height, not the upright container's height more.
+        assert X_tilted[2, 3] < X_kept[2, 3] - 0.05
+
+
 @pytest.mark.parametrize("task, where", [("pourOut", dict(pour_at=(0.7, -0.25))),
                                          ("pourIn", dict(fill_at=(0.65, -0.25, 0.3)))])
 def test_a_pour_places_at_the_target_else_back_where_it_was_picked(task, where):

@@ -495,6 +495,7 @@ def _pours(placing: TaskPlacing | None, obstacles, target: ObjectDescription,
     pours = pour_poses(np.asarray(target.X_WO, float), target.extents, X_WG,
                        bowl_xy=placing.pour_at, bowl_top=box_top(bowl.X_WO, bowl.extents),
                        tilt=placing.pour_tilt, clearance=placing.pour_clearance,
+                       drop=placing.pour_drop,
                        yaws=placing.pour_yaws)
     if not pours:
         return [], f"pour pose: {target_name(target)} is not upright"
