@@ -154,7 +154,7 @@ def test_a_tilted_pour_is_lowered_to_pour_from_just_above_the_bowl(tilt_deg):
                       tilt=np.deg2rad(tilt_deg), clearance=0.05)
     lowered = pour_poses(X_WO, extents, X_WG, bowl_xy=bowl_xy, bowl_top=bowl_top,
                          tilt=np.deg2rad(tilt_deg), clearance=0.05, drop=0.03)
-    for (X_pour, X_kept), (X_pour2, X_tilted) in zip(kept, lowered):
+    for (X_pour, X_kept), (X_pour2, X_tilted) in zip(kept, lowered, strict=True):
         assert np.allclose(X_pour, X_pour2)  # the upright pose above the bowl is the same
         assert np.isclose(box_bottom(X_tilted, extents), bowl_top + 0.03)
         assert np.allclose(X_tilted[:3, :3], X_kept[:3, :3])  # turned alike, only moved down
