@@ -148,6 +148,7 @@ def test_unreachable_place_is_not_a_collision_of_the_part():
     r = plan_pick_and_place(c, target=BOX, place_xy=(1.6, 0.0))
     assert r.status == "unreachable"
     assert r.unreachable_parts == ()  # the top can be picked: no collision(top) evidence
+    assert r.picked_parts == ("top",)
     assert r.part_reachable == {"top": True}
     assert r.candidate_reasons[0].startswith("pre-place pose unreachable")
     assert "picked but not placed at (1.600, 0.000) m: pre-place pose unreachable" in r.reason

@@ -157,4 +157,5 @@ def test_unreachable_place_gives_up_without_blaming_the_part():
     simulator.AdvanceTo(0.01)
     s = status(planner, context)
     assert (s.status, s.unreachable_parts, s.failed_part) == ("failed", (), None)
+    assert s.picked_parts == ("top",)  # the supervisor's reason: unreachable, not would_not_hold
     assert "picked but not placed" in s.reason

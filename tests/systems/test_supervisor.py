@@ -248,6 +248,28 @@ def test_a_part_that_would_not_hold_is_told_apart_from_an_unreachable_one():
     assert "no grasp on bottom would hold" in o.detail
 
 
+def test_a_part_picked_but_not_placed_fails_as_unreachable_though_another_would_not_hold():
+    """The bottom would not hold; the top can be picked but the place (or pour) pose is out of
+    reach: the run ends unreachable, not would_not_hold."""
+    import dataclasses
+
+    unholdable = dataclasses.replace(GRASPS, unholdable_parts=("bottom",))
+    f = Fixed(grasps=unholdable)
+    f.advance(0.001)
+    picked_not_placed = dataclasses.replace(
+        failed(1, None, reason="the object can be picked but not placed at (0.850, -0.300) m: "
+               "pour pose unreachable"), picked_parts=("top",))
+    f.plan(picked_not_placed)
+    f.advance(0.011)
+    f.meaning(semantics(part={"bottom": 0.0, "top": 1.0}))
+    f.advance(0.021)
+    f.plan(dataclasses.replace(picked_not_placed, attempt=2))
+    f.advance(0.031)
+    o = f.outcome
+    assert (o.status, o.reason) == ("failed", "unreachable")
+    assert "pour pose unreachable" in o.detail
+
+
 def test_no_plan_within_the_planning_timeout_fails_as_timeout():
     f = Fixed()
     f.advance(0.49)

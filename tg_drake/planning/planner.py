@@ -211,6 +211,8 @@ class PlanResult:
     planning_time: float = 0.0  # [s] wall time
     candidate: int | None = None
     part: str | None = None
+    picked_parts: tuple = ()  # examined parts some candidate of which can be picked (when no
+    # plan: picked, but not placed, poured or handed over)
 
 
 def place_pose(X_WO: np.ndarray, extents, place_xy, *, table_z: float = 0.0,
@@ -427,8 +429,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             reason = ("the object can be picked but not placed at "
                       f"({place_xy[0]:.3f}, {place_xy[1]:.3f}) m: "
                       + max(examined or [first], key=_stage))  # the first farthest
+        picked = tuple(p for p in parts_order if part_pickable.get(p))
         return PlanResult("unreachable", None, costs, tuple(reasons), part_reachable,
-                          unreachable, reason, elapsed)
+                          unreachable, reason, elapsed, picked_parts=picked)
     return PlanResult("planned", plan, costs, tuple(reasons), part_reachable, unreachable, "",
                       elapsed, plan.candidate, plan.part)
 

@@ -250,9 +250,12 @@ class GraspPlanner(LeafSystem):
                                         **common))
             return
         if memory.failure_reason:
-            unreachable = memory.failure.unreachable_parts if memory.failure is not None else ()
-            output.set_value(PlanStatus(PlanState.failed, unreachable_parts=tuple(unreachable),
-                                        reason=memory.failure_reason, **common))
+            failure = memory.failure
+            output.set_value(PlanStatus(
+                PlanState.failed,
+                unreachable_parts=tuple(failure.unreachable_parts) if failure else (),
+                picked_parts=tuple(failure.picked_parts) if failure else (),
+                reason=memory.failure_reason, **common))
             return
         output.set_value(PlanStatus(PlanState.planning, **common))
 

@@ -48,6 +48,8 @@ class PlanStatus:
     candidate: int | None = None  # index of the chosen candidate in the ranked_grasps it came from
     X_WG: np.ndarray | None = None  # 4×4 chosen grasp pose
     unreachable_parts: tuple = ()  # parts of this attempt none of whose candidates can be picked
+    picked_parts: tuple = ()  # parts of this attempt some candidate of which can be picked, though
+    # no plan was found (placed, poured or handed over out of reach)
     reason: str = ""  # why the attempt failed (status "failed"), else ""
     planning_time: float = 0.0  # [s] wall time spent in the planner so far
     t_plan: float | None = None  # [s] simulated time at which the plan starts

@@ -503,8 +503,10 @@ class Supervisor(LeafSystem):
         new = tuple(p for p in status.unreachable_parts if p not in told)
         # Parts the feasibility stage found no holding grasp on: not unreachable, told apart.
         held = tuple(p for p in grasps.unholdable_parts if p not in told and p not in new)
-        # No part blamed for reach, and some would not hold: the run fails for holding.
-        holding = not status.unreachable_parts and bool(memory.no_hold + held)
+        # No part blamed for reach, none picked but then not placed (a place, pour or hand-over
+        # out of reach), and some would not hold: the run fails for holding.
+        holding = (not status.unreachable_parts and not status.picked_parts
+                   and bool(memory.no_hold + held))
         reason = Reason.would_not_hold if holding else Reason.unreachable
         if holding:
             why = f"no grasp on {', '.join(memory.no_hold + held)} would hold; {why}"
