@@ -109,7 +109,7 @@ def test_an_upside_down_placing_tries_higher_releases():
 
 
 @pytest.mark.parametrize("field, value", [("pour_tilt", 0.0), ("pour_hold", -1.0),
-                                          ("turned_release_heights", [])])
+                                          ("pour_drop", -0.01), ("turned_release_heights", [])])
 def test_a_bad_task_motion_config_names_its_field(field, value):
     with pytest.raises(ScenarioError, match=field):
         TaskMotionConfig(**{field: value}).validate()
