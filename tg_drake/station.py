@@ -47,14 +47,17 @@ from pydrake.geometry import (
     AddRigidHydroelasticProperties,
     Box,
     CollisionFilterDeclaration,
+    Convex,
     GeometryInstance,
     GeometrySet,
     MakePhongIllustrationProperties,
     MakeRenderEngineGl,
+    Mesh,
     PerceptionProperties,
     ProximityProperties,
     RenderEngineGlParams,
     Rgba,
+    Role,
     SceneGraph,
     Sphere,
     kHasRenderEngineGl,
@@ -98,6 +101,7 @@ from tg_drake.scenario import (
     placement_X_TO,
     resolve_objects,
 )
+from tg_drake.support_hull import support_hull
 from tg_drake.table import add_surfaces, add_table
 from tg_drake.tasks.contents import (
     DISPENSER_WALL,
@@ -185,8 +189,8 @@ def _apply_joint_pd(plant: MultibodyPlant, instance: ModelInstanceIndex, kp: flo
 
 
 def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser,
-                 contents: list[ContentsModel], visible: bool = False
-                 ) -> dict[str, ModelInstanceIndex]:
+                 contents: list[ContentsModel], visible: bool = False,
+                 scene_graph: SceneGraph | None = None) -> dict[str, ModelInstanceIndex]:
     if not scenario.objects:
         return {}
     # User libraries and mesh entries (a validated scenario's paths are absolute; the import is
@@ -201,6 +205,8 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser,
         objects[placement.instance_name] = instance
         body = plant.get_body(plant.GetBodyIndices(instance)[0])
         plant.SetDefaultFloatingBaseBodyPose(body, placement_pose(scenario, placement))
+        if scene_graph is not None:
+            add_support_hull(plant, scene_graph, body)
         if placement.containment == "full" and scenario.contents.model == "spheres":
             contents.append(_add_sphere_contents(plant, placement, get_object(placement.id),
                                                  placement_pose(scenario, placement),
@@ -208,6 +214,62 @@ def _add_objects(scenario: Scenario, plant: MultibodyPlant, parser: Parser,
         elif placement.containment == "full":
             _add_contents(plant, instance, body, get_object(placement.id))
     return objects
+
+
+SUPPORT_HULL = "support_hull"  # name of an object's table-contact geometry
+
+
+@functools.lru_cache(maxsize=256)
+def _support_hull_of(vertices: bytes) -> np.ndarray:
+    return support_hull(np.frombuffer(vertices).reshape(-1, 3))
+
+
+def add_support_hull(plant: MultibodyPlant, scene_graph: SceneGraph, body) -> None:
+    """Registers `body`'s support hull (`tg_drake.support_hull`) as a collision geometry named
+    SUPPORT_HULL with the proximity properties (rigid hydroelastic, friction) of its first mesh,
+    built from the convex hulls of all its mesh and convex collision geometries (before
+    Finalize; `support_hulls_touch_only_the_table` filters the pairs after it). A body without
+    such geometry gets none."""
+    inspector = scene_graph.model_inspector()
+    points, properties = [], None
+    for g in plant.GetCollisionGeometriesForBody(body):
+        shape = inspector.GetShape(g)
+        if not isinstance(shape, Mesh | Convex):
+            continue
+        hull = shape.GetConvexHull()
+        V = np.array([hull.vertex(i) for i in range(hull.num_vertices())])
+        points.append(inspector.GetPoseInFrame(g).multiply(V.T).T)
+        properties = properties or ProximityProperties(inspector.GetProximityProperties(g))
+    if not points:
+        return
+    P = _support_hull_of(np.ascontiguousarray(np.vstack(points), float).tobytes())
+    shape = Convex(np.asarray(P, float).T.copy(), SUPPORT_HULL)
+    plant.RegisterCollisionGeometry(body, RigidTransform(), shape, SUPPORT_HULL, properties)
+
+
+def support_hulls_touch_only_the_table(plant: MultibodyPlant, scene_graph: SceneGraph,
+                                       table: ModelInstanceIndex, objects) -> None:
+    """Collision filters (after Finalize): each object's support hull touches only the table and
+    its surfaces, and its other geometry everything but them."""
+    inspector = scene_graph.model_inspector()
+    support = set()
+    for bodies in (plant.GetBodyIndices(i) for i in objects):
+        for b in bodies:
+            support |= {g for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))
+                        if inspector.GetName(g).endswith(SUPPORT_HULL)}
+    if not support:
+        return
+    table_geometries = {g for b in plant.GetBodyIndices(table)
+                        for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))}
+    meshes = {g for i in objects for b in plant.GetBodyIndices(i)
+              for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))} - support
+    others = set(inspector.GetAllGeometryIds(Role.kProximity)) - table_geometries
+    manager = scene_graph.collision_filter_manager()
+    manager.Apply(CollisionFilterDeclaration().ExcludeBetween(
+        GeometrySet(list(support)), GeometrySet(list(others))))
+    if meshes:
+        manager.Apply(CollisionFilterDeclaration().ExcludeBetween(
+            GeometrySet(list(meshes)), GeometrySet(list(table_geometries))))
 
 
 def contents_cylinder(obj) -> tuple[float, float, np.ndarray]:
@@ -395,7 +457,7 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
     instances["table"] = add_table(plant, scenario.table_size, X_WT)
     add_surfaces(plant, instances["table"], scenario.surfaces)
     contents: list[ContentsModel] = []
-    objects = _add_objects(scenario, plant, parser, contents, contents_visible)
+    objects = _add_objects(scenario, plant, parser, contents, contents_visible, scene_graph)
     instances.update(objects)
     if scenario.dispenser is not None:
         dispensed, _ = _add_dispenser(plant, scenario, contents_visible)
@@ -422,6 +484,8 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
 
     station = Station(scenario=scenario, plant=plant, scene_graph=scene_graph,
                       instances=instances, objects=objects, cameras={}, contents=contents)
+    support_hulls_touch_only_the_table(plant, scene_graph, instances["table"],
+                                       list(objects.values()))
     if contents and not scenario.contents.mutual:
         exclude_mutual_contact(plant, scene_graph, contents)
     if scenario.dispenser is not None:
