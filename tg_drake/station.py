@@ -252,17 +252,16 @@ def support_hulls_touch_only_the_table(plant: MultibodyPlant, scene_graph: Scene
     """Collision filters (after Finalize): each object's support hull touches only the table and
     its surfaces, and its other geometry everything but them."""
     inspector = scene_graph.model_inspector()
-    support = set()
-    for bodies in (plant.GetBodyIndices(i) for i in objects):
-        for b in bodies:
-            support |= {g for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))
-                        if inspector.GetName(g).endswith(SUPPORT_HULL)}
+    # The object's own body (the first of its model instance; a full container's spheres are
+    # bodies of the instance too and keep the table).
+    own = {g for i in objects
+           for g in plant.GetCollisionGeometriesForBody(plant.get_body(plant.GetBodyIndices(i)[0]))}
+    support = {g for g in own if inspector.GetName(g).endswith(SUPPORT_HULL)}
     if not support:
         return
     table_geometries = {g for b in plant.GetBodyIndices(table)
                         for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))}
-    meshes = {g for i in objects for b in plant.GetBodyIndices(i)
-              for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))} - support
+    meshes = own - support
     others = set(inspector.GetAllGeometryIds(Role.kProximity)) - table_geometries
     manager = scene_graph.collision_filter_manager()
     manager.Apply(CollisionFilterDeclaration().ExcludeBetween(

@@ -39,8 +39,10 @@ SPHERE_RADIUS = 0.008  # [m] measured: 14–36 lattice sites in the library's cu
 # (10 mm: 4–18, too coarse a measure of a poured fraction)
 MAX_SPHERES = 10  # [1] measured: a fill is at most this many spheres (the lowest sites first);
 # the cost is proportional to it, and 10 still resolves a poured fraction to 0.1
-SPHERE_MODULUS = 1e7  # [Pa] hydroelastic modulus, measured (1e6: a sphere sinks 3.5 mm of its
-# 8 mm radius into the table; 1e8: no cheaper)
+SPHERE_MODULUS = 1e8  # [Pa] hydroelastic modulus, measured (1e6: a sphere sinks 3.5 mm of its
+# 8 mm radius into the table; 1e7: dropped 15 cm from a dispenser into a bowl, one sank 5.7 mm
+# into its 2.9 mm bottom — through it and into the table top; 1e8: 2.1 mm; the cost barely
+# depends on it, above)
 SPHERE_RESOLUTION = 0.016  # [m] hydroelastic mesh resolution hint (the coarsest sphere), measured
 # (4 mm doubled the pour's cost)
 SPHERE_DISSIPATION = 5.0  # [s/m] Hunt–Crossley dissipation (little bounce)
