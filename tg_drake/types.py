@@ -112,8 +112,9 @@ class ObjectDescription:
     # description).
     pose_cue: str = ""  # what decided the pose (perception.pose.PoseEstimate.cue), or "".
     pose_end: tuple | None = None  # the closed end on top, (recess, dome, rise, rise error)
-    # [m] and its wall's (narrowing, error) [m/m] (NaN: no wall), when the pose reached that cue
-    # (perception.pose.closed_end, wall_taper), else None.
+    # [m], its wall's (narrowing, error) [m/m] (NaN: no wall) and 1.0 when the end radii read
+    # the top narrower than the base (else 0.0), when the pose reached that cue
+    # (perception.pose.closed_end, wall_taper, PoseEstimate.narrower_top), else None.
 
 
 @dataclass

@@ -81,9 +81,10 @@ def decide(d, model: ClosedEndModel | None) -> tuple[str, str]:
     perceived with another: only the closed-end cue's decisions change)."""
     if d.pose_end is None or model is None:
         return d.pose, d.pose_cue
-    narrowing, error = d.pose_end[4:]
+    narrowing, error, narrower_top = d.pose_end[4:]
     wall = None if np.isnan(narrowing) else WallTaper(narrowing, error)
-    top_sign, cue = closed_end_decision(model, ClosedEnd(*d.pose_end[:4]), wall)
+    top_sign, cue = closed_end_decision(model, ClosedEnd(*d.pose_end[:4]), wall,
+                                        narrower_top=bool(narrower_top))
     return ("upright" if top_sign > 0 else "upsidedown"), cue
 
 

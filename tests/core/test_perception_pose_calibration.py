@@ -132,3 +132,45 @@ def test_a_flat_closed_top_is_upright_unless_the_wall_narrows_or_the_end_is_push
     for name, (c, n) in cases.items():
         end = closed_end(c, n)
         assert closed_end_decision(model, end, wall_taper(c, n)) == (signs[name], name), name
+
+
+def test_a_base_read_wider_by_noise_is_no_taper_and_a_drafted_wall_is():
+    """The taper cue's end radii are one quantile of each end's slice: a few points read wider
+    at a straight can's base (the sensor's noise) make its base wider than its top. The wall's
+    fit (`wall_taper`, medians per height bin) does not move, so `taper_confirmed` refuses that
+    taper and keeps a wall that narrows by its draft."""
+    from tg_drake.perception.pose import END_SLICE, RADIUS_QUANTILE, taper_confirmed
+
+    c, n = _frustum(0.03, 0.03)
+    # A fifth as many points as the lowest 15 % of the wall holds, 6 mm wider, facing out.
+    low = c.p_T[:, 2] < END_SLICE * 0.12
+    k = max(1, int(0.2 * np.count_nonzero(low & (np.abs(n[:, 2]) < 0.5))))
+    t = np.linspace(-np.pi / 2, np.pi / 2, k)
+    z = np.linspace(0.004, 0.015, k)
+    ring = np.c_[0.036 * np.cos(t), 0.036 * np.sin(t), z]
+    c.p_T = np.vstack([c.p_T, ring])
+    c.visible = np.ones(len(c.p_T), bool)
+    c.handle = np.zeros(len(c.p_T), bool)
+    n = np.vstack([n, np.c_[np.cos(t), np.sin(t), np.zeros(k)]])
+    r = np.hypot(c.p_T[:, 0], c.p_T[:, 1])
+    r_low = np.quantile(r[c.p_T[:, 2] < END_SLICE * 0.12], RADIUS_QUANTILE)
+    r_high = np.quantile(r[c.p_T[:, 2] > (1 - END_SLICE) * 0.12], RADIUS_QUANTILE)
+    assert r_high < 0.9 * r_low  # [m] the end radii read a strong taper ...
+    assert not taper_confirmed(c, n)  # ... the wall says it is straight
+    assert taper_confirmed(*_frustum(0.04, 0.034))  # a 2.9° draft: an upside-down tumbler
+
+
+def test_a_flat_end_on_a_straight_wall_leaves_the_decision_to_the_end_radii_a_lid_does_not():
+    """A taper the wall does not confirm goes to the closed end: a recessed lid says upright
+    whatever the end radii read; a flat end shows nothing, so the radii's narrower top decides
+    (upside-down, "taper"), and without it the usual pose stands (upright, "flat")."""
+    from tg_drake.perception.pose import closed_end, closed_end_decision, wall_taper
+
+    model = load_pose_calibration().closed_end
+    H = 0.12
+    flat = _frustum(0.03, 0.03)
+    lid = _frustum(0.03, 0.03, top_height=lambda r: H if r > 0.0225 else H - 0.004)
+    for (c, n), narrower, expected in ((flat, True, (-1.0, "taper")), (flat, False, (1.0, "flat")),
+                                       (lid, True, (1.0, "lid"))):
+        assert closed_end_decision(model, closed_end(c, n), wall_taper(c, n),
+                                   narrower_top=narrower) == expected

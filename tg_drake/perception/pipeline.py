@@ -82,7 +82,8 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
         pose_likelihood=pose.likelihood, pose_cue=pose.cue,
         pose_end=None if pose.end is None else (
             pose.end.recess, pose.end.dome, pose.end.rise, pose.end.rise_error,
-            *((np.nan, np.nan) if pose.wall is None else (pose.wall.narrowing, pose.wall.error))),
+            *((np.nan, np.nan) if pose.wall is None else (pose.wall.narrowing, pose.wall.error)),
+            float(pose.narrower_top)),
         part_probabilities=parts.probabilities, part_boxes=boxes,
         pregrasp_X_WG=X_WG, pregrasp_parts=grasp_parts, containment=None, is_tool=parts.is_tool,
         interior_seen=seen, interior_hidden=1.0 - seen)

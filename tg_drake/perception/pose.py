@@ -17,7 +17,10 @@ in order:
 4. **Taper.** A closed top narrower than the base otherwise, narrowing steadily from a rim on the
    table (already at mid-height, or strongly at the top: a can's rolled rim narrows only its last
    centimetre, and only a little), is the shape of a tapered open container (glass, cup, bowl,
-   pan) resting on its rim: upside-down.
+   pan) resting on its rim: upside-down — when the side wall, where it is measured, narrows
+   beyond its noise too (`taper_confirmed`: the end radii alone read noise at the base as a
+   taper). Otherwise the closed end decides, and where it shows no shape (a flat end on a
+   straight wall) the end radii do.
 5. **Closed end.** A closed, straight end on top: a lid (upright) or the
    object's own base (upside-down), told by its shape rather than by the outline: a lid is
    recessed below a rim by a band of depths; a base is flat, or domed up from its centre (a
@@ -243,22 +246,23 @@ class ClosedEndModel:
         return float(1.0 / (1.0 + np.exp(-x)))
 
 
-def closed_end_decision(model: ClosedEndModel, end: ClosedEnd, wall: WallTaper | None
-                        ) -> tuple[float, str]:
+def closed_end_decision(model: ClosedEndModel, end: ClosedEnd, wall: WallTaper | None, *,
+                        narrower_top: bool = False) -> tuple[float, str]:
     """(top sign, cue) of a closed end on top. The model reads the end's shape: a lid recessed
     below its rim says upright ("lid"). What it reads as a base must show it by more than the
     lack of a lid, since a flat closed top (a solid block's, a closed box's) looks like a flat
     base: the end is pushed in beyond its noise (a can's bottom: "base"), or the wall narrows
     from the table up (a container resting on its wider rim: "rim"). A flat end on a straight
-    wall says nothing of which end is up: upright, the usual pose ("flat"; its calibrated
-    likelihood says how often that is wrong)."""
+    wall says nothing of which end is up: the end radii decide when they read the top narrower
+    than the base (`narrower_top`: the taper cue the wall did not confirm, "taper"), else
+    upright, the usual pose ("flat"; the calibrated likelihoods say how often each is wrong)."""
     if model.p_upsidedown(end) <= 0.5:
         return 1.0, "lid"
     if end.shaped:
         return -1.0, "base"
     if wall is not None and wall.significant:
         return -1.0, "rim"
-    return 1.0, "flat"
+    return (-1.0, "taper") if narrower_top else (1.0, "flat")
 
 
 @dataclass(frozen=True)
@@ -322,6 +326,7 @@ class PoseEstimate:
     inward_share: float = 0.0  # ... and their share of the visible body points.
     end: ClosedEnd | None = None  # the closed end on top, when the decision reached that cue ...
     wall: WallTaper | None = None  # ... and its side wall's narrowing upwards.
+    narrower_top: bool = False  # the end radii read the top narrower than the base (taper cue)
 
 
 def inward_facing(p: np.ndarray, n: np.ndarray, p_A: np.ndarray, a: np.ndarray) -> np.ndarray:
@@ -360,6 +365,16 @@ def _handle_end(c: Completion) -> int:
     lo, hi = s_body.min(), s_body.max()
     f = (s_handle - lo) / max(hi - lo, 1e-9)
     return 1 if f > 1.0 - HANDLE_END else (-1 if f < HANDLE_END else 0)
+
+
+def taper_confirmed(c: Completion, n_visible_T: np.ndarray) -> bool:
+    """The end radii's narrowing (the taper cue) is the wall's: where the side wall is measured
+    (`wall_taper`), it narrows upwards beyond its noise. The end radii are one quantile of each
+    end's slice, and the sensor's noise moves them: a straight can's base read 2–10 mm wider
+    than its top on perceived views (D415 model). Without a measured wall (a squat object) the
+    radii decide."""
+    wall = wall_taper(c, n_visible_T)
+    return wall is None or wall.significant
 
 
 def tool_pose(c: Completion, cfg: PoseConfig | None = None) -> PoseEstimate:
@@ -410,6 +425,10 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
     cavity = (inward.sum() >= cfg.min_cavity_points
               and inward.mean() >= cfg.min_cavity_share)
     r_low, r_mid, r_high = _profile_radii(c)
+    # The taper cue's end radii: the top narrower than the base (steadily, or strongly at the top).
+    narrower_top = bool(r_high < cfg.taper_ratio * r_low
+                        and (r_mid < cfg.taper_body_ratio * r_low
+                             or r_high < cfg.strong_taper_ratio * r_low))
     handle_end = _handle_end(c)
     if c.vertical:
         # The cue that places the top, and which end it says.
@@ -419,14 +438,16 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
             top_sign, cue = float(handle_end), "handle"
         elif r_high < cfg.neck_ratio * r_low and r_mid >= cfg.neck_body_ratio * r_low:
             top_sign, cue = 1.0, "neck"
-        elif r_high < cfg.taper_ratio * r_low and (r_mid < cfg.taper_body_ratio * r_low
-                                                   or r_high < cfg.strong_taper_ratio * r_low):
+        elif narrower_top and taper_confirmed(c, n_visible_T):
             top_sign, cue = -1.0, "taper"
         else:  # the closed end (measured with or without a model: the calibration's input)
             end = closed_end(c, n_visible_T)
             wall = None if end is None else wall_taper(c, n_visible_T)
             if end is not None and calibration.closed_end is not None:
-                top_sign, cue = closed_end_decision(calibration.closed_end, end, wall)
+                top_sign, cue = closed_end_decision(calibration.closed_end, end, wall,
+                                                    narrower_top=narrower_top)
+            elif narrower_top:
+                top_sign, cue = -1.0, "taper"
             else:
                 top_sign, cue = 1.0, "straight"
     else:
@@ -445,4 +466,4 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
     total = sum(likelihood.values())
     return PoseEstimate(pose, {k: likelihood[k] / total for k in POSES}, top_sign, cue,
                         int(inward.sum()), float(inward.mean()) if len(inward) else 0.0, end,
-                        wall)
+                        wall, narrower_top and c.vertical)
