@@ -139,9 +139,10 @@ def test_a_base_read_wider_by_noise_is_no_taper_and_a_drafted_wall_is():
     at a straight can's base (the sensor's noise) make its base wider than its top. The wall's
     fit (`wall_taper`, medians per height bin) does not move, so `taper_confirmed` refuses that
     taper and keeps a wall that narrows by its draft."""
-    from tg_drake.perception.pose import END_SLICE, RADIUS_QUANTILE, taper_confirmed
+    from tg_drake.perception.pose import END_SLICE, _profile_radii, taper_confirmed, wall_taper
 
     c, n = _frustum(0.03, 0.03)
+    c.axis_T = np.array([0.0, 0.0, 1.0])
     # A fifth as many points as the lowest 15 % of the wall holds, 6 mm wider, facing out.
     low = c.p_T[:, 2] < END_SLICE * 0.12
     k = max(1, int(0.2 * np.count_nonzero(low & (np.abs(n[:, 2]) < 0.5))))
@@ -152,12 +153,11 @@ def test_a_base_read_wider_by_noise_is_no_taper_and_a_drafted_wall_is():
     c.visible = np.ones(len(c.p_T), bool)
     c.handle = np.zeros(len(c.p_T), bool)
     n = np.vstack([n, np.c_[np.cos(t), np.sin(t), np.zeros(k)]])
-    r = np.hypot(c.p_T[:, 0], c.p_T[:, 1])
-    r_low = np.quantile(r[c.p_T[:, 2] < END_SLICE * 0.12], RADIUS_QUANTILE)
-    r_high = np.quantile(r[c.p_T[:, 2] > (1 - END_SLICE) * 0.12], RADIUS_QUANTILE)
+    r_low, _, r_high = _profile_radii(c)
     assert r_high < 0.9 * r_low  # [m] the end radii read a strong taper ...
-    assert not taper_confirmed(c, n)  # ... the wall says it is straight
-    assert taper_confirmed(*_frustum(0.04, 0.034))  # a 2.9° draft: an upside-down tumbler
+    assert not taper_confirmed(wall_taper(c, n))  # ... the wall says it is straight
+    # A 2.9° draft (an upside-down tumbler) is a taper.
+    assert taper_confirmed(wall_taper(*_frustum(0.04, 0.034)))
 
 
 def test_a_flat_end_on_a_straight_wall_leaves_the_decision_to_the_end_radii_a_lid_does_not():

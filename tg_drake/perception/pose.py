@@ -367,13 +367,12 @@ def _handle_end(c: Completion) -> int:
     return 1 if f > 1.0 - HANDLE_END else (-1 if f < HANDLE_END else 0)
 
 
-def taper_confirmed(c: Completion, n_visible_T: np.ndarray) -> bool:
+def taper_confirmed(wall: WallTaper | None) -> bool:
     """The end radii's narrowing (the taper cue) is the wall's: where the side wall is measured
     (`wall_taper`), it narrows upwards beyond its noise. The end radii are one quantile of each
     end's slice, and the sensor's noise moves them: a straight can's base read 2–10 mm wider
-    than its top on perceived views (D415 model). Without a measured wall (a squat object) the
-    radii decide."""
-    wall = wall_taper(c, n_visible_T)
+    than its top on perceived views (D415 model). Without a measured wall (None: a squat
+    object) the radii decide."""
     return wall is None or wall.significant
 
 
@@ -438,11 +437,12 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
             top_sign, cue = float(handle_end), "handle"
         elif r_high < cfg.neck_ratio * r_low and r_mid >= cfg.neck_body_ratio * r_low:
             top_sign, cue = 1.0, "neck"
-        elif narrower_top and taper_confirmed(c, n_visible_T):
+        elif narrower_top and taper_confirmed(wall := wall_taper(c, n_visible_T)):
             top_sign, cue = -1.0, "taper"
         else:  # the closed end (measured with or without a model: the calibration's input)
             end = closed_end(c, n_visible_T)
-            wall = None if end is None else wall_taper(c, n_visible_T)
+            if end is not None and not narrower_top:  # (with a narrower top: measured above)
+                wall = wall_taper(c, n_visible_T)
             if end is not None and calibration.closed_end is not None:
                 top_sign, cue = closed_end_decision(calibration.closed_end, end, wall,
                                                     narrower_top=narrower_top)
