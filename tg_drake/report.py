@@ -126,7 +126,8 @@ def result_of(*, scenario, scenario_path: str, stages: Stages, outcome, plan_sta
         result["planning"] = {"status": plan_status.status.value, "attempt": plan_status.attempt,
                               "part": plan_status.part,
                               "unreachable_parts": list(outcome.unreachable_parts),
-                              "requeries": outcome.requeries, "reason": plan_status.reason}
+                              "requeries": outcome.requeries, "reason": plan_status.reason,
+                              "ik_solves": plan_status.ik_solves}
         if plan_status.plan is not None:
             i = plan_status.candidate
             ranked = stages.ranked

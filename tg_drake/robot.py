@@ -118,6 +118,33 @@ X_7G[:3, 3] = X_7G_XYZ
 X_7G.flags.writeable = False
 
 
+# --- The arm's reach -----------------------------------------------------------------------------
+# Joint 4 alone sets the distance from the shoulder (joints 1–2) to the wrist centre (link 6's
+# origin, where the axes of joints 5–7 meet): the wrist centre lies in a spherical shell about the
+# shoulder, whatever the other joints. A gripper pose whose wrist centre is outside that shell has
+# no inverse kinematics: a necessary condition, not a sufficient one.
+_SHOULDER_Z = IIWA_JOINTS[0].xyz[2] + IIWA_JOINTS[1].xyz[2]  # [m] above the base
+_UPPER_ARM = abs(IIWA_JOINTS[2].xyz[1]) + abs(IIWA_JOINTS[3].xyz[2])  # [m] joint 2 → joint 4
+_FOREARM = abs(IIWA_JOINTS[4].xyz[1]) + abs(IIWA_JOINTS[5].xyz[2])  # [m] joint 4 → joint 6
+WRIST_SHELL = (  # [m] the shortest (joint 4 at its limit) and longest (straight) wrist distance
+    math.sqrt(_UPPER_ARM ** 2 + _FOREARM ** 2
+              - 2 * _UPPER_ARM * _FOREARM * math.cos(math.pi - IIWA_JOINTS[3].limit)),
+    _UPPER_ARM + _FOREARM)
+WRIST_OFFSET_G = abs(IIWA_JOINTS[6].xyz[1]) + X_7G_XYZ[2]  # [m] the wrist centre back along −y_G
+# from G (link 7's axis is y_G)
+
+
+def wrist_reach_margin(X_BG: np.ndarray) -> float:
+    """[m] how far inside the iiwa's reachable shell (`WRIST_SHELL`) the wrist centre of gripper
+    pose X_BG (in the iiwa's base frame: link 0, joint 1 along its z) lies: negative when no
+    joint configuration within joint 4's range puts the gripper there, whatever the other joints
+    (a necessary condition of the inverse kinematics, not a sufficient one)."""
+    X = np.asarray(X_BG, float)
+    wrist = X[:3, 3] - WRIST_OFFSET_G * X[:3, 1]
+    d = float(np.linalg.norm(wrist - np.array([0.0, 0.0, _SHOULDER_Z])))
+    return min(d - WRIST_SHELL[0], WRIST_SHELL[1] - d)
+
+
 def wsg_pad_boxes(opening: float = WSG_MAX_OPENING) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
     """The two finger pads in G at the given opening [m] (distance between their inner faces):
     ((centre, full size), (centre, full size)) for the left (−x_G) and the right (+x_G) pad."""

@@ -370,6 +370,7 @@ class PipelineConfig:
             raise ScenarioError(f"no such DGI model file {self.scoring.model!r}",
                                 field=f"{where}.scoring.model")
         self.expansion.validate(f"{where}.expansion")
+        self.planner.validate(f"{where}.planner")
         self.feasibility.validate(f"{where}.feasibility")
         self.supervisor.validate(f"{where}.supervisor")
         self.tasks.validate(f"{where}.tasks")

@@ -19,8 +19,8 @@ from tg_drake.planning.handover import (
     mount_pose,
     receiver_motion,
     robot_gripper_points,
-    wrist_reach_margin,
 )
+from tg_drake.robot import wrist_reach_margin
 from tg_drake.tasks.judge import PASS_HEIGHT_TOLERANCE, judge_pass
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription
 

@@ -5,19 +5,27 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from grasp_helpers import GRASP_POINT, grasp_pose
+from grasp_helpers import GRASP_POINT, grasp_pose, scene_with_box
 from pydrake.math import RigidTransform, RotationMatrix
 
 from tg_drake.grasping.expansion import ExpansionConfig, retreat_above_table
-from tg_drake.planning.ik import CONSTRAINT_TOLERANCE, clearance, make_arm_plant, solve_ik_seeds
+from tg_drake.planning import ik
+from tg_drake.planning.ik import (
+    CONSTRAINT_TOLERANCE,
+    beyond_reach,
+    clearance,
+    make_arm_plant,
+    solve_ik_seeds,
+)
 from tg_drake.planning.planner import (
     TABLE_CLEARANCE,
     PlannerConfig,
     place_pose,
     plan_pick_and_place,
 )
+from tg_drake.planning.regrasp import plan_task_leg
 from tg_drake.planning.trajectory import IIWA_VELOCITY_LIMITS
-from tg_drake.robot import IIWA_HOME
+from tg_drake.robot import IIWA_HOME, IIWA_POSITION_LIMITS, wrist_reach_margin
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, PartBox
 
 # The IK tolerances of PlannerConfig: 2 mm per axis (so up to 2·√3 mm), 0.02 rad; plus what the
@@ -100,6 +108,50 @@ def test_pregrasp_into_the_box_is_refused_when_the_box_is_an_obstacle():
     r = solve_ik_seeds(arm, RigidTransform(deep), [np.array(IIWA_HOME)], min_distance=0.003)
     assert not r.success
     assert "clearance" in r.reason
+
+
+def test_a_pose_beyond_the_arms_reach_fails_without_a_solver_call(monkeypatch):
+    arm = make_arm_plant()
+    far = grasp_pose([1.3, 0.0, 0.2], approach_W=[1, 0, 0], closing_W=[0, 1, 0])
+    monkeypatch.setattr(ik, "solve_ik", lambda *a, **k: pytest.fail("the solver was called"))
+    r = solve_ik_seeds(arm, RigidTransform(far), [np.array(IIWA_HOME)], min_distance=0.003)
+    assert not r.success
+    assert "out of reach" in r.reason
+    # The wrist centre 1.3 − 0.055 − 0.195 m out, 0.16 m below the shoulder: 0.23 m past 0.82 m.
+    assert r.position_error == pytest.approx(0.23, abs=0.01)
+
+
+def test_an_ik_without_clearance_is_asked_once_per_pose_and_seed_whatever_the_obstacles():
+    """Its answer depends on the arm's kinematics only: a second arm plant with an obstacle (the
+    clearance IK then runs again) gets the remembered one, the same configuration."""
+    X = RigidTransform(SIDE)
+    bare = solve_ik_seeds(make_arm_plant(), X, [np.array(IIWA_HOME)], min_distance=None)
+    n = ik.ik_solves()
+    arm = make_arm_plant(obstacles=[("far", RigidTransform([0.0, 0.9, 0.1]), (0.1, 0.1, 0.1))])
+    again = solve_ik_seeds(arm, X, [np.array(IIWA_HOME)], min_distance=None)
+    assert ik.ik_solves() == n and again.success and bare.success
+    np.testing.assert_array_equal(again.q, bare.q)
+    clear = solve_ik_seeds(arm, X, [np.array(IIWA_HOME)], min_distance=0.003)
+    assert ik.ik_solves() == n + 1 and clear.success  # only the clearance IK was solved
+
+
+def test_no_pose_the_arm_reaches_is_beyond_reach():
+    """Forward kinematics of configurations across the joint ranges, joint 4 straight and at
+    both limits among them (the shell's two boundaries, where the margin is 0): none is refused
+    even with no tolerance, and the boundaries are tight (the shell is exact, not loose)."""
+    arm = make_arm_plant()
+    rng = np.random.default_rng(0)
+    qs = rng.uniform(-IIWA_POSITION_LIMITS, IIWA_POSITION_LIMITS, (150, 7))
+    qs[:50, 3] = 0.0
+    qs[50:100, 3] = IIWA_POSITION_LIMITS[3] * np.where(np.arange(50) % 2, 1.0, -1.0)
+    for k, q in enumerate(qs):
+        arm.plant.SetPositions(arm.plant_context, arm.full_q(q))
+        X_WG = arm.G.CalcPoseInWorld(arm.plant_context)
+        assert beyond_reach(arm, X_WG, 0.0, 0.0) == 0.0
+        margin = wrist_reach_margin(X_WG.GetAsMatrix4())
+        assert margin >= -1e-5  # [m] the model files' rounding of the kinematic table
+        if k < 100:
+            assert margin == pytest.approx(0.0, abs=1e-5)
 
 
 def test_velocity_limits_are_the_robot_facts():
@@ -680,3 +732,44 @@ def test_the_placed_object_is_its_part_shapes_moved_not_its_whole_box():
                            finger_contact=["box"])
     assert not solve_ik_seeds(whole, RigidTransform(X_WG_place), [np.array(IIWA_HOME)],
                               min_distance=0.003).success
+
+
+def test_a_plan_request_stops_where_its_ik_budget_runs_out():
+    """Placed out of the arm's reach, every candidate is picked and fails at the place: without
+    a budget all are examined; with a budget of one solve the request ends after the first
+    candidate's pick and says why."""
+    scene = scene_with_box([0.75, 0.1, 0.10])
+    c = candidates([(SIDE, "top"), (TOP, "top"), (SIDE, "middle")])
+    far = (0.0, -1.2)  # [m] beyond the arm's reach
+    free = plan_task_leg(scene, c, place_xy=far, q_start=IIWA_HOME,
+                         config=PlannerConfig(max_ik_solves=None))
+    assert free.status == "unreachable" and not free.out_of_budget
+    assert "max_ik_solves" not in free.reason
+    tight = plan_task_leg(scene, c, place_xy=far, q_start=IIWA_HOME,
+                          config=PlannerConfig(max_ik_solves=1))
+    assert tight.status == "unreachable" and tight.out_of_budget
+    assert "the planning budget of 1 inverse-kinematics solves ran out" in tight.reason
+    assert 1 <= tight.ik_solves < free.ik_solves
+    assert np.isnan(tight.costs).sum() > np.isnan(free.costs).sum()  # candidates not examined
+
+
+def test_a_budget_that_suffices_leaves_the_plan_as_it_is():
+    scene = scene_with_box([0.75, 0.1, 0.10])
+    c = candidates([(SIDE, "top"), (TOP, "top")])
+    plans = [plan_task_leg(scene, c, place_xy=PLACE_XY, q_start=IIWA_HOME,
+                           config=PlannerConfig(max_ik_solves=n)) for n in (None, 10_000)]
+    assert [r.status for r in plans] == ["planned", "planned"]
+    assert plans[0].candidate == plans[1].candidate
+    assert plans[0].ik_solves > 0  # (the second asks fewer: the answers without clearance
+    # constraints are remembered, ik.FREE_IK_MEMO)
+    np.testing.assert_array_equal(plans[0].plan.q(plans[0].plan.duration),
+                                  plans[1].plan.q(plans[1].plan.duration))
+
+
+def test_an_ik_budget_below_one_names_its_field():
+    from tg_drake.errors import ScenarioError
+
+    with pytest.raises(ScenarioError) as e:
+        PlannerConfig(max_ik_solves=0).validate()
+    assert e.value.field == "pipeline.planner.max_ik_solves"
+    assert "must be >= 1 or null" in str(e.value)

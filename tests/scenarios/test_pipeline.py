@@ -81,6 +81,8 @@ def test_default_scenario_passes_the_cup_by_its_middle(cached_run):
     # What the run used is what it reports: planning done, no collision evidence, and the full
     # resolved configuration (the supervisor's settings included).
     assert result["planning"]["status"] == "done"
+    assert 0 < result["planning"]["ik_solves"] < result["config"]["pipeline"]["planner"][
+        "max_ik_solves"]  # the planner's effort, well within its budget
     assert result["collisions"] == result["outcome"]["unreachable_parts"] == []
     assert result["config"]["pipeline"]["supervisor"]["max_requeries"] == 3
     assert result["config"]["objects"][0]["id"] == "cup_01"

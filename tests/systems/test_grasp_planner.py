@@ -111,10 +111,28 @@ def test_unreachable_leading_part_is_reported_and_the_next_attempt_leaves_it_out
     assert (status(planner, context).status, status(planner, context).attempt) == ("failed", 1)
     planner.get_plan_request_input_port().FixValue(
         context, PlanRequest(attempt=2, exclude_parts=("bottom",)))
+    n1 = s.ik_solves
     simulator.AdvanceTo(START + 0.11)  # the next event, 0.05 s later
     s = status(planner, context)
     assert (s.status, s.attempt, s.part, s.candidate) == ("executing", 2, "top", 2)
     assert s.t_plan == pytest.approx(START + 0.10, abs=1e-9)
+    assert s.ik_solves > n1  # summed over the requests answered
+
+
+def test_a_request_that_runs_out_of_its_ik_budget_fails_and_says_so():
+    """Placed out of reach, with a budget of one solver call: the request ends after the first
+    candidate's pick, failed, its reason naming the setting."""
+    planner = GraspPlanner(place_xy=(0.0, -1.2), start_time=START,
+                           config=PlannerConfig(max_ik_solves=1))
+    context = fixed_inputs(planner, SCENE, ranked([(TOP, "top"), (SIDE, "top")]))
+    planner.get_plan_request_input_port().FixValue(context, PlanRequest(attempt=1))
+    simulator = Simulator(planner, context)
+    simulator.Initialize()
+    simulator.AdvanceTo(START + 0.01)
+    s = status(planner, context)
+    assert (s.status, s.attempt) == ("failed", 1)
+    assert "(pipeline.planner.max_ik_solves)" in s.reason
+    assert s.ik_solves >= 1
 
 
 def test_without_a_request_nothing_is_planned():

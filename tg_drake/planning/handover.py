@@ -46,7 +46,6 @@ Arrays in, arrays out: no Drake.
 
 
 
-import functools
 import hashlib
 import math
 from dataclasses import dataclass, field
@@ -62,7 +61,7 @@ from tg_drake.grasping.feasibility import (
     grip_width,
     gripper_boxes,
 )
-from tg_drake.robot import IIWA_JOINTS, WSG_GRASP_POINT_G, WSG_MAX_OPENING, WSG_PAD_SIZE, X_7G_XYZ
+from tg_drake.robot import WSG_GRASP_POINT_G, WSG_MAX_OPENING, WSG_PAD_SIZE, wrist_reach_margin
 from tg_drake.tasks.judge import PASS_HOLD_DURATION
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription
 
@@ -248,31 +247,6 @@ class Handover:
         X = np.array(X_WO, float)
         X[:3, 3] = self.point
         return X
-
-
-@functools.cache
-def _arm_shell() -> tuple[np.ndarray, float, float, float]:
-    """The iiwa's shoulder centre (3,) [m] in the world (its base at the origin, joint 1 along z),
-    the shortest and longest distances [m] from it to the wrist centre (link 6's origin, where
-    joints 5–7 meet) that joint 4's range allows, and the wrist centre's offset [m] back along −y_G
-    from the WSG frame G: all from the robot's kinematic table (tg_drake.robot)."""
-    j = IIWA_JOINTS
-    shoulder = np.array([0.0, 0.0, j[0].xyz[2] + j[1].xyz[2]])
-    upper = abs(j[2].xyz[1]) + abs(j[3].xyz[2])  # joint 2 → joint 4 (elbow)
-    fore = abs(j[4].xyz[1]) + abs(j[5].xyz[2])  # joint 4 → joint 6 (wrist centre)
-    bend = j[3].limit  # [rad] the elbow's largest bend from straight
-    shortest = math.sqrt(upper ** 2 + fore ** 2 - 2 * upper * fore * math.cos(math.pi - bend))
-    return shoulder, shortest, upper + fore, abs(j[6].xyz[1]) + X_7G_XYZ[2]
-
-
-def wrist_reach_margin(X_WG: np.ndarray) -> float:
-    """[m] how far inside the iiwa's reachable shell (`_arm_shell`) the wrist centre of gripper pose
-    X_WG lies: negative when no joint configuration within joint 4's range puts the gripper
-    there, whatever the other joints (a necessary condition of the IK, not a sufficient one)."""
-    shoulder, shortest, longest, wrist_g = _arm_shell()
-    X = np.asarray(X_WG, float)
-    d = float(np.linalg.norm(X[:3, 3] - wrist_g * X[:3, 1] - shoulder))
-    return min(d - shortest, longest - d)
 
 
 def handover_object_poses(handover: "Handover", X_WO: np.ndarray, X_WG: np.ndarray, *,

@@ -10,7 +10,11 @@ smallest signed distance of a configuration for checking a path after it is plan
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import contextlib
+import dataclasses
+import hashlib
+from collections import OrderedDict
+from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.geometry import Box, CollisionFilterDeclaration, Cylinder, GeometrySet, Sphere
@@ -24,10 +28,12 @@ from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 from tg_drake.robot import (
     IIWA_HOME,
     IIWA_JOINT_NAMES,
+    WRIST_OFFSET_G,
     WSG_BODY,
     WSG_FINGER_JOINTS,
     WSG_FINGERS,
     WSG_MAX_OPENING,
+    wrist_reach_margin,
 )
 from tg_drake.robot_plants import add_scenario_models
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, add_table
@@ -35,6 +41,10 @@ from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, add_table
 # The scenario's models in the planning plant: the robot and the gripper (the table is added from
 # the scenario's table_size); loose objects become obstacles if at all.
 PLANNING_MODELS = ("iiwa", "wsg")
+
+# The IK's default pose tolerances: [m] per axis of G's position, [rad] of its orientation.
+IK_POSITION_TOLERANCE = 0.002
+IK_ANGLE_TOLERANCE = 0.02
 
 # Weight of the IK's pull towards its seed [1/rad²]: a preference among the solutions that meet
 # the (hard) pose and clearance constraints.
@@ -53,6 +63,10 @@ class ArmPlant:
     obstacles: list  # (name, X_WB, size) boxes added as obstacles
     iiwa_indices: np.ndarray = None  # (7,) positions of the iiwa joints in the plant's q
     q_fingers: np.ndarray = None  # (nq,) plant positions with the fingers at the opening (iiwa 0)
+    X_BW: np.ndarray = field(default_factory=lambda: np.eye(4))  # 4×4 world → the iiwa's base
+    # (link 0) frame
+    kinematics: bytes = b""  # a fingerprint of what an IK without clearance constraints depends
+    # on (`_kinematics`): arm plants that differ only in their obstacles share it
 
     def full_q(self, q_iiwa) -> np.ndarray:
         """The plant's position vector for iiwa joint positions `q_iiwa` (fingers as held)."""
@@ -138,8 +152,26 @@ def make_arm_plant(scenario = None, *, obstacles=(),
     G = plant.GetFrameByName(WSG_BODY, wsg)
     iiwa_indices = np.array([plant.GetJointByName(n, iiwa).position_start()
                              for n in IIWA_JOINT_NAMES])
+    X_WB = plant.EvalBodyPoseInWorld(plant_context, plant.GetBodyByName("iiwa_link_0", iiwa))
+    q_fingers = plant.GetPositions(plant_context).copy()
     return ArmPlant(diagram, plant, scene_graph, context, plant_context, G, iiwa, added,
-                    iiwa_indices, plant.GetPositions(plant_context).copy())
+                    iiwa_indices, q_fingers, X_WB.inverse().GetAsMatrix4(),
+                    _kinematics(plant, G, iiwa_indices, q_fingers))
+
+
+def _kinematics(plant, G, iiwa_indices, q_fingers) -> bytes:
+    """A fingerprint of the arm plant's kinematics as the IK sees them without clearance
+    constraints: the joint limits, the fingers' positions and G's pose in the world at three
+    configurations (any change of the chain, its mounting or the gripper's frame changes them)."""
+    context = plant.CreateDefaultContext()
+    parts = [plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits(), q_fingers]
+    for q_iiwa in (np.array(IIWA_HOME), np.zeros(7), np.linspace(0.3, -0.3, 7)):
+        q = q_fingers.copy()
+        q[iiwa_indices] = q_iiwa
+        plant.SetPositions(context, q)
+        parts.append(G.CalcPoseInWorld(context).GetAsMatrix4())
+    return hashlib.sha1(b"".join(np.ascontiguousarray(p, float).tobytes()
+                                 for p in parts)).digest()
 
 
 def clearance(arm: ArmPlant, q_iiwa, max_distance: float = 0.1) -> float:
@@ -161,7 +193,8 @@ class IkResult:
 
 
 def solve_ik(arm: ArmPlant, X_WG: RigidTransform, *, q_seed=IIWA_HOME,
-             position_tolerance: float = 0.002, angle_tolerance: float = 0.02,
+             position_tolerance: float = IK_POSITION_TOLERANCE,
+             angle_tolerance: float = IK_ANGLE_TOLERANCE,
              min_distance: float | None = 0.005, max_iterations: int = 100,
              q_guess=None) -> IkResult:
     """Joint positions putting G at X_WG within tolerances, inside joint limits and (when
@@ -198,6 +231,7 @@ def solve_ik(arm: ArmPlant, X_WG: RigidTransform, *, q_seed=IIWA_HOME,
     options = SolverOptions()
     options.SetOption(SnoptSolver().solver_id(), "Major iterations limit", max_iterations)
     result = Solve(prog, solver_options=options)
+    _SOLVES.count += 1
     q_sol = result.GetSolution(q)
     plant.SetPositions(arm.plant_context, q_sol)
     err = float(np.linalg.norm(arm.G.CalcPoseInWorld(arm.plant_context).translation() - p))
@@ -226,6 +260,88 @@ def satisfies_constraints(result, prog, tolerance: float = CONSTRAINT_TOLERANCE)
                for b in prog.GetAllConstraints()) and np.all(np.isfinite(x))
 
 
+# [m] added to the tolerances' bound in `beyond_reach`: the solver's accepted constraint violation
+# (1e-5 on the orientation constraint's cosine is about 2.5e-4 rad at 0.02 rad, 0.05 mm at the
+# wrist's offset), with room to spare.
+REACH_SLACK = 0.001
+
+
+def beyond_reach(arm: ArmPlant, X_WG: RigidTransform, position_tolerance: float,
+                 angle_tolerance: float) -> float:
+    """[m] how far the wrist centre of gripper pose X_WG lies outside the arm's reachable shell
+    (`tg_drake.robot.wrist_reach_margin`) beyond what an IK solution within the tolerances may
+    move it (its position error, up to √3 × `position_tolerance` [m], and its turn, up to
+    `angle_tolerance` [rad], about G at the wrist's offset; `REACH_SLACK` for the solver's
+    constraint tolerance): > 0 means no joint configuration reaches the pose; 0 otherwise."""
+    slack = (np.sqrt(3.0) * (position_tolerance + CONSTRAINT_TOLERANCE)
+             + WRIST_OFFSET_G * angle_tolerance + REACH_SLACK)
+    margin = wrist_reach_margin(arm.X_BW @ X_WG.GetAsMatrix4())
+    return max(0.0, -margin - slack)
+
+
+class _Solves:
+    """The IK solver calls of this process (`count`) and where the planning budget open now
+    ends (`limit`, a count; None: no budget)."""
+
+    count = 0
+    limit: int | None = None
+
+
+_SOLVES = _Solves()
+
+
+def ik_solves() -> int:
+    """How many IK solver calls this process has made (remembered answers and poses refused
+    as beyond reach are not solver calls)."""
+    return _SOLVES.count
+
+
+@contextlib.contextmanager
+def solve_budget(n: int | None):
+    """Within: `budget_spent()` is True once `n` more IK solver calls have been made (None: no
+    budget). A budget opened inside another keeps the outer one: a planning request's budget
+    covers every leg and check it plans."""
+    if _SOLVES.limit is not None or n is None:
+        yield
+        return
+    _SOLVES.limit = _SOLVES.count + int(n)
+    try:
+        yield
+    finally:
+        _SOLVES.limit = None
+
+
+def budget_spent() -> bool:
+    """Whether the open planning budget (`solve_budget`) has been used up."""
+    return _SOLVES.limit is not None and _SOLVES.count >= _SOLVES.limit
+
+
+# An IK without clearance constraints depends on the arm's kinematics (`ArmPlant.kinematics`),
+# the pose, the seed and the tolerances only, not on the obstacles; a planning call asks for the
+# same pose from many places (the pick poses again for each place variant, the place poses again
+# for each spot of a place-and-regrasp). Its answers are kept for the process, the least recently
+# used dropped beyond FREE_IK_MEMO entries (each under 1 kB).
+FREE_IK_MEMO = 20_000
+_free_ik_memo: OrderedDict = OrderedDict()
+
+
+def _free_ik(arm: ArmPlant, X_WG: RigidTransform, q_seed, kwargs: dict) -> IkResult:
+    """`solve_ik` from `q_seed` without clearance constraints, remembered (`FREE_IK_MEMO`);
+    a copy, so that the caller may change it."""
+    key = (arm.kinematics, X_WG.GetAsMatrix4().tobytes(),
+           np.asarray(q_seed, float).tobytes(), tuple(sorted(kwargs.items())))
+    result = _free_ik_memo.get(key) if arm.kinematics else None
+    if result is None:
+        result = solve_ik(arm, X_WG, q_seed=q_seed, min_distance=None, **kwargs)
+        if arm.kinematics:
+            _free_ik_memo[key] = result
+            if len(_free_ik_memo) > FREE_IK_MEMO:
+                _free_ik_memo.popitem(last=False)
+    else:
+        _free_ik_memo.move_to_end(key)
+    return dataclasses.replace(result, q=result.q.copy())
+
+
 def solve_ik_seeds(arm: ArmPlant, X_WG: RigidTransform, seeds, *,
                    min_distance: float | None = 0.005, **kwargs) -> IkResult:
     """`solve_ik` from each seed in turn (the IK is local): the first success, else the last
@@ -235,13 +351,22 @@ def solve_ik_seeds(arm: ArmPlant, X_WG: RigidTransform, seeds, *,
     milliseconds, and it fails fast where the pose is out of reach); only its solution, when there
     is one and it differs from the ones already tried, starts the IK with the minimum-distance
     constraints. `kwargs` go to `solve_ik`.
+
+    A pose whose wrist centre lies outside the arm's reachable shell by more than the pose
+    tolerances let the solution move it (`beyond_reach`) fails at once, without a solver call.
     """
     if len(seeds) == 0:
         raise ValueError("solve_ik_seeds needs at least one seed")
+    outside = beyond_reach(arm, X_WG, kwargs.get("position_tolerance", IK_POSITION_TOLERANCE),
+                           kwargs.get("angle_tolerance", IK_ANGLE_TOLERANCE))
+    if outside > 0.0:
+        return IkResult(False, np.asarray(seeds[-1], float), outside,
+                        f"out of reach within the joint limits (the wrist centre "
+                        f"{1000 * outside:.0f} mm beyond the arm's reach)")
     result = None
     tried = []
     for q_seed in seeds:
-        free = solve_ik(arm, X_WG, q_seed=q_seed, min_distance=None, **kwargs)
+        free = _free_ik(arm, X_WG, q_seed, kwargs)
         if min_distance is None or not free.success:
             result = free
             if free.success:

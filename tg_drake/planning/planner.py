@@ -49,6 +49,7 @@ import numpy as np
 from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
+from tg_drake.errors import ScenarioError
 from tg_drake.grasping.feasibility import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.logic.receive import receiver_parts
 from tg_drake.planning.handover import (
@@ -57,7 +58,13 @@ from tg_drake.planning.handover import (
     handover_object_poses,
     receiver_motion,
 )
-from tg_drake.planning.ik import ArmPlant, arm_surface_points, make_arm_plant, solve_ik_seeds
+from tg_drake.planning.ik import (
+    ArmPlant,
+    arm_surface_points,
+    budget_spent,
+    make_arm_plant,
+    solve_ik_seeds,
+)
 from tg_drake.planning.task_motion import (
     TaskPlacing,
     bowl_of,
@@ -81,6 +88,12 @@ from tg_drake.robot import (
     WSG_PALM_Y,
 )
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, SceneDescription
+
+# A plan request's budget of inverse-kinematics solver calls (PlannerConfig.max_ik_solves): a
+# compute bound, not a fitted number. A request that plans explores a few hundred to a few thousand
+# (tens of seconds on a 2-core machine); one that fails can otherwise explore every candidate,
+# place yaw and intermediate pose of a place-and-regrasp (tens of thousands: ten minutes).
+MAX_IK_SOLVES = 6000
 
 
 @dataclass
@@ -139,6 +152,9 @@ class PlannerConfig:
     place_yaws: list[float] = field(  # [deg] turns of the object
         default_factory=lambda: [0.0, 60.0, -60.0, 120.0, -120.0, 180.0])
     # about the vertical tried at the place, in order (the first one that can be planned).
+    max_ik_solves: int | None = MAX_IK_SOLVES  # a plan request's budget of inverse-kinematics
+    # solver calls, its place-and-regrasp search included (None: no budget): where it runs out,
+    # the request ends without a plan and says so (`budget_reason`)
     max_candidates_per_part: int = 12  # scored hypotheses per part (each with its approach
     # variants, `GraspCandidates.source`) that reach the inverse kinematics before the part is
     # given up.
@@ -148,6 +164,21 @@ class PlannerConfig:
     carry_limits: SegmentLimits = field(default_factory=lambda: SegmentLimits(
         velocity_scale=0.5, min_duration=1.0))  # carrying the object to the pre-place
     segment: SegmentConfig = field(default_factory=SegmentConfig)
+
+    def validate(self, where: str = "pipeline.planner") -> None:
+        """Raises ScenarioError naming the field a value is out of its range in."""
+        if self.max_ik_solves is not None and self.max_ik_solves < 1:
+            raise ScenarioError(f"must be >= 1 or null (no budget), got {self.max_ik_solves}",
+                                field=f"{where}.max_ik_solves")
+        if self.max_candidates_per_part < 1:
+            raise ScenarioError(f"must be >= 1, got {self.max_candidates_per_part}",
+                                field=f"{where}.max_candidates_per_part")
+
+
+def budget_reason(config: PlannerConfig) -> str:
+    """What a plan request that ran out of its budget says."""
+    return (f"the planning budget of {config.max_ik_solves} inverse-kinematics solves ran out "
+            f"(pipeline.planner.max_ik_solves)")
 
 
 @dataclass(frozen=True)
@@ -213,6 +244,8 @@ class PlanResult:
     part: str | None = None
     picked_parts: tuple = ()  # examined parts some candidate of which can be picked (when no
     # plan: picked, but not placed, poured or handed over)
+    ik_solves: int = 0  # inverse-kinematics solver calls of the request (`plan_task_leg`)
+    out_of_budget: bool = False  # the request's budget (PlannerConfig.max_ik_solves) ran out
 
 
 def place_pose(X_WO: np.ndarray, extents, place_xy, *, table_z: float = 0.0,
@@ -319,7 +352,11 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
     receiver_cache: dict = {}  # a pass: the receiver's feasibility per robot grasp
     tried: dict[str, set] = {name: set() for name in parts_order}
     plan = None
+    out_of_budget = False
     for i in order:
+        if budget_spent():
+            out_of_budget = True
+            break
         part = PART_LABELS[int(candidates.parts[i])]
         if part not in tried or (source[i] not in tried[part]
                                  and len(tried[part]) >= config.max_candidates_per_part):
@@ -362,6 +399,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         failed_pours = set()
         for k_pour, pour, R_turn, X_WO_place_yawed in [
                 (k, pour, R, X) for k, pour in enumerate(pours) for R, X in places]:
+            if budget_spent():
+                out_of_budget = True
+                break
             if k_pour in failed_pours:
                 continue
             key = _key_poses(arms, X_WG, X_WO, X_WO_place_yawed, config, R_turn=R_turn,
@@ -414,7 +454,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             costs[i] = -np.log(score[i])
             found = True
             break
-        if found:
+        if found or out_of_budget:
             break
 
     elapsed = time.perf_counter() - t_start
@@ -429,9 +469,12 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             reason = ("the object can be picked but not placed at "
                       f"({place_xy[0]:.3f}, {place_xy[1]:.3f}) m: "
                       + max(examined or [first], key=_stage))  # the first farthest
+        if out_of_budget:
+            reason += f" (then {budget_reason(config)})"
         picked = tuple(p for p in parts_order if part_pickable.get(p))
         return PlanResult("unreachable", None, costs, tuple(reasons), part_reachable,
-                          unreachable, reason, elapsed, picked_parts=picked)
+                          unreachable, reason, elapsed, picked_parts=picked,
+                          out_of_budget=out_of_budget)
     return PlanResult("planned", plan, costs, tuple(reasons), part_reachable, unreachable, "",
                       elapsed, plan.candidate, plan.part)
 

@@ -38,6 +38,7 @@ from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 from tg_drake.grasping.expansion import ExpansionConfig, executed_poses
 from tg_drake.perception.config import PregraspConfig
 from tg_drake.perception.pregrasp import part_pregrasps
+from tg_drake.planning.ik import budget_spent, ik_solves, solve_budget
 from tg_drake.planning.planner import (
     PICK_POSES,
     TURNED_IN_HAND,
@@ -49,6 +50,7 @@ from tg_drake.planning.planner import (
     _seeds,
     _task_place_variants,
     _waypoint_configurations,
+    budget_reason,
     place_pose,
     plan_for_scene,
     plan_pick_and_place,
@@ -170,6 +172,8 @@ def second_leg_reachable(moved: ObjectDescription, parts, *, placing: TaskPlacin
     centroid = np.asarray(moved.p_W, float).mean(axis=0) if len(moved.p_W) else None
     why = ""
     for i in order[:max_grasps]:
+        if budget_spent():
+            return why or budget_reason(config)
         part = PART_LABELS[int(labels[i])]
         X_WG = X_WG_all[i]
         refusal = _refusal(moved, part, X_WG, centroid, config, table_z)
@@ -240,6 +244,8 @@ def plan_regrasp_leg(candidates: GraspCandidates, *, target: ObjectDescription, 
     tried, planned_legs = [], 0
     total_time = direct.planning_time
     for inter in intermediates(target, placing, obstacles)[:placing.regrasp_max_poses]:
+        if budget_spent():  # (plan_task_leg's reason says so)
+            break
         label = (f"{inter.pose} turned {np.rad2deg(inter.yaw):.0f} deg at "
                  f"({inter.X_WO[0, 3]:.3f}, {inter.X_WO[1, 3]:.3f}) m")
         carried = None
@@ -345,7 +351,24 @@ def plan_task_leg(scene, candidates: GraspCandidates, *, place_xy, q_start, regr
     """`tg_drake.planning.planner.plan_for_scene`, and where a p&pIn* task's turn in the hand
     cannot be placed: with `regrasp`, a place-and-regrasp's first leg (`plan_regrasp_leg`);
     without, the reason says that none was allowed. With `return_home` every plan ends with the
-    arm back at `q_start` (a regrasp leg does anyway)."""
+    arm back at `q_start` (a regrasp leg does anyway). The whole request keeps within the
+    budget `PlannerConfig.max_ik_solves`; `PlanResult.ik_solves` says what it used."""
+    config = kwargs.get("config") or PlannerConfig()
+    n0 = ik_solves()
+    with solve_budget(config.max_ik_solves):
+        result = _plan_task_leg(scene, candidates, place_xy=place_xy, q_start=q_start,
+                                regrasp=regrasp, return_home=return_home, **kwargs)
+        spent = budget_spent()
+    out = result.status != "planned" and (result.out_of_budget or spent)
+    reason = result.reason
+    if out and budget_reason(config) not in reason:
+        reason += f" (then {budget_reason(config)})"
+    return dataclasses.replace(result, ik_solves=ik_solves() - n0, out_of_budget=out,
+                               reason=reason)
+
+
+def _plan_task_leg(scene, candidates: GraspCandidates, *, place_xy, q_start, regrasp: bool,
+                   return_home: bool, **kwargs) -> PlanResult:
     result = plan_for_scene(scene, candidates, place_xy=place_xy, q_start=q_start, **kwargs)
     if result.status == "planned" and return_home:
         target = scene.objects[candidates.target]

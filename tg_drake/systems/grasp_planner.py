@@ -40,6 +40,7 @@ class _Memory:
     failure: PlanResult | None = None  # the last answered attempt's failed result
     failure_reason: str = ""  # its reason (also for failures without a PlanResult)
     planning_time: float = 0.0  # [s] wall time
+    ik_solves: int = 0  # inverse-kinematics solver calls of every request answered
 
     def __deepcopy__(self, memo):
         return self  # immutable: the simulator's state copies may share it
@@ -208,6 +209,7 @@ class GraspPlanner(LeafSystem):
                                    category=semantics.category if semantics else None,
                                    regrasp=request.regrasp,
                                    return_home=request.return_home)
+            memory = dataclasses.replace(memory, ik_solves=memory.ik_solves + result.ik_solves)
             if result.status == "planned":
                 memory = dataclasses.replace(memory, result=result, t_plan=context.get_time())
             else:
@@ -240,7 +242,8 @@ class GraspPlanner(LeafSystem):
 
     def _calc_status(self, context, output):
         memory = self._memory_of(context)
-        common = dict(attempt=memory.attempt, planning_time=memory.planning_time)
+        common = dict(attempt=memory.attempt, planning_time=memory.planning_time,
+                      ik_solves=memory.ik_solves)
         if memory.result is not None:
             plan = memory.result.plan
             done = context.get_time() - memory.t_plan >= plan.duration

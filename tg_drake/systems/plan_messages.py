@@ -52,6 +52,7 @@ class PlanStatus:
     # no plan was found (placed, poured or handed over out of reach)
     reason: str = ""  # why the attempt failed (status "failed"), else ""
     planning_time: float = 0.0  # [s] wall time spent in the planner so far
+    ik_solves: int = 0  # inverse-kinematics solver calls of the planner so far
     t_plan: float | None = None  # [s] simulated time at which the plan starts
     plan: Plan | None = None  # the plan itself (key times in plan time: add t_plan)
 
