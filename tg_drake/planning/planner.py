@@ -246,6 +246,7 @@ class PlanResult:
     # plan: picked, but not placed, poured or handed over)
     ik_solves: int = 0  # inverse-kinematics solver calls of the request (`plan_task_leg`)
     out_of_budget: bool = False  # the request's budget (PlannerConfig.max_ik_solves) ran out
+    # before a plan was found (`plan_task_leg`)
 
 
 def place_pose(X_WO: np.ndarray, extents, place_xy, *, table_z: float = 0.0,
@@ -352,10 +353,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
     receiver_cache: dict = {}  # a pass: the receiver's feasibility per robot grasp
     tried: dict[str, set] = {name: set() for name in parts_order}
     plan = None
-    out_of_budget = False
     for i in order:
-        if budget_spent():
-            out_of_budget = True
+        if budget_spent():  # (plan_task_leg's reason says so)
             break
         part = PART_LABELS[int(candidates.parts[i])]
         if part not in tried or (source[i] not in tried[part]
@@ -400,7 +399,6 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         for k_pour, pour, R_turn, X_WO_place_yawed in [
                 (k, pour, R, X) for k, pour in enumerate(pours) for R, X in places]:
             if budget_spent():
-                out_of_budget = True
                 break
             if k_pour in failed_pours:
                 continue
@@ -454,7 +452,7 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             costs[i] = -np.log(score[i])
             found = True
             break
-        if found or out_of_budget:
+        if found or budget_spent():
             break
 
     elapsed = time.perf_counter() - t_start
@@ -469,12 +467,9 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
             reason = ("the object can be picked but not placed at "
                       f"({place_xy[0]:.3f}, {place_xy[1]:.3f}) m: "
                       + max(examined or [first], key=_stage))  # the first farthest
-        if out_of_budget:
-            reason += f" (then {budget_reason(config)})"
         picked = tuple(p for p in parts_order if part_pickable.get(p))
         return PlanResult("unreachable", None, costs, tuple(reasons), part_reachable,
-                          unreachable, reason, elapsed, picked_parts=picked,
-                          out_of_budget=out_of_budget)
+                          unreachable, reason, elapsed, picked_parts=picked)
     return PlanResult("planned", plan, costs, tuple(reasons), part_reachable, unreachable, "",
                       elapsed, plan.candidate, plan.part)
 

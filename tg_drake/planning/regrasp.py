@@ -359,10 +359,8 @@ def plan_task_leg(scene, candidates: GraspCandidates, *, place_xy, q_start, regr
         result = _plan_task_leg(scene, candidates, place_xy=place_xy, q_start=q_start,
                                 regrasp=regrasp, return_home=return_home, **kwargs)
         spent = budget_spent()
-    out = result.status != "planned" and (result.out_of_budget or spent)
-    reason = result.reason
-    if out and budget_reason(config) not in reason:
-        reason += f" (then {budget_reason(config)})"
+    out = spent and result.status != "planned"
+    reason = result.reason + (f" (then {budget_reason(config)})" if out else "")
     return dataclasses.replace(result, ik_solves=ik_solves() - n0, out_of_budget=out,
                                reason=reason)
 
