@@ -9,9 +9,10 @@ view). Two fits on these views:
 1. the closed-end model (`tg_drake.perception.pose.ClosedEndModel`): a logistic regression of
    "upside-down" on the closed top's features (`ClosedEnd.features`) over the upright and
    upside-down views whose pose decision reached that cue;
-2. per (decision, cue) — the pose perception decides (with that model) and the cue that decided
-   it — the true poses are counted; `PoseCalibration` turns the counts into P(true pose |
-   decision, cue).
+2. per (decision, cue) — the pose perception decides (with that model, and a flat closed end
+   taken as the end the views that reached it rested on more often: `flat_sign`) and the cue
+   that decided it — the true poses are counted; `PoseCalibration` turns the counts into
+   P(true pose | decision, cue).
 
     .venv/bin/python tools/calibrate_pose.py  # → tg_drake/data/pose_likelihood.json
     .venv/bin/python tools/calibrate_pose.py --sensor ideal --out /tmp/pose.json
@@ -76,16 +77,24 @@ def fit_closed_end(views: list[tuple]) -> tuple[ClosedEndModel | None, int]:
                           bias=float(fit.intercept_[0])), len(used)
 
 
-def decide(d, model: ClosedEndModel | None) -> tuple[str, str]:
-    """(pose, cue) perception decides for a view with this closed-end model (the view was
-    perceived with another: only the closed-end cue's decisions change)."""
+def decide(d, model: ClosedEndModel | None, flat_sign: float = 1.0) -> tuple[str, str]:
+    """(pose, cue) perception decides for a view with this closed-end model and flat end's sign
+    (the view was perceived with others: only the closed-end cue's decisions change)."""
     if d.pose_end is None or model is None:
         return d.pose, d.pose_cue
     narrowing, error, narrower_top = d.pose_end[4:]
     wall = None if np.isnan(narrowing) else WallTaper(narrowing, error)
     top_sign, cue = closed_end_decision(model, ClosedEnd(*d.pose_end[:4]), wall,
-                                        narrower_top=bool(narrower_top))
+                                        narrower_top=bool(narrower_top), flat_sign=flat_sign)
     return ("upright" if top_sign > 0 else "upsidedown"), cue
+
+
+def flat_sign(views: list[tuple], model: ClosedEndModel | None) -> float:
+    """The flat end's sign (`PoseCalibration.flat_sign`) these views give: the true poses of
+    those whose decision reached the "flat" cue, counted as the calibration counts them."""
+    counts = {"any/flat": collections.Counter(
+        pose for pose, d in views if decide(d, model)[1] == "flat")}
+    return PoseCalibration(counts=counts).flat_sign
 
 
 def main(argv=None) -> int:
@@ -118,8 +127,9 @@ def main(argv=None) -> int:
     if model is None and args.closed_end:
         print("the closed-end model needs upright and upside-down views: not fitted",
               file=sys.stderr)
+    sign = flat_sign(views, model)
     for pose, d in views:
-        counts["/".join(decide(d, model))][pose] += 1
+        counts["/".join(decide(d, model, sign))][pose] += 1
     name = getattr(sensor, "name", type(sensor).__name__)
     out = {"source": f"tools/calibrate_pose.py --sensor {args.sensor} ({name}): {len(ids)} "
                      f"training objects, their resting poses at yaws {list(YAWS_DEG)}; {n} views, "

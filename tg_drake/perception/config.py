@@ -87,7 +87,8 @@ class PoseConfig:
     min_interior_share: float = 0.12  # the `interior_seen` observation: this share of the
     # visible body points faces into the object (pose.interior_seen).
     neck_ratio: float = 0.6  # top radius below this share of the base radius is a neck ...
-    neck_body_ratio: float = 0.95  # ... over a body this wide at mid-height (else a taper).
+    neck_body_ratio: float = 0.95  # ... over a body this wide at mid-height, or a straight
+    # lower wall under a shoulder (pose.shoulder) (else a taper).
     taper_ratio: float = 0.95  # top radius below this share of the base radius is a taper ...
     taper_body_ratio: float = 0.98  # ... narrowing already at mid-height (a can's rim does not)
     strong_taper_ratio: float = 0.9  # ... or narrowing this much at the top.

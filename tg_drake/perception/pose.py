@@ -13,7 +13,9 @@ in order:
 2. **Handle.** A handle at one end of the body marks the top: pans and pots carry their
    handles at the rim (a cup's handle spans the middle of its side and says nothing).
 3. **Neck.** With no cavity seen, the top is closed. A top much narrower than the base over a
-   body as wide as the base at mid-height is a neck: an upright bottle.
+   body as wide as the base at mid-height is a neck: an upright bottle. A bottle whose shoulder
+   begins below mid-height shows it by its wall (`shoulder`): straight in the lower half, then
+   narrowing, where an upside-down container narrows from the table up.
 4. **Taper.** A closed top narrower than the base otherwise, narrowing steadily from a rim on the
    table (already at mid-height, or strongly at the top: a can's rolled rim narrows only its last
    centimetre, and only a little), is the shape of a tapered open container (glass, cup, bowl,
@@ -30,7 +32,10 @@ in order:
    base must show it by evidence other than the missing lid (`closed_end_decision`): the end
    pushed in beyond its noise ("base": a can's bottom), or the wall narrowing from the table up
    to the top beyond its noise (`wall_taper`, "rim": an open container rests on its rim, its
-   wider end); a flat end on a straight wall is taken as upright ("flat"). Without enough
+   wider end). A flat end on a straight wall ("flat") says nothing of which end it is by
+   itself: the decision is the end the training views that reached it rested on more often
+   (`PoseCalibration.flat_sign`: our containers' flat bases — a flat-topped solid standing is
+   not among our categories; an upright can shows a recessed lid). Without enough
    points on the top (an open top seen from the side) or without a fitted model, the next cue
    decides.
 6. Otherwise (closed and straight, like a can) the object is taken as upright: standing upright
@@ -47,6 +52,7 @@ The thresholds of the cues (`PoseConfig`) were chosen on renders of our object l
 
 from __future__ import annotations
 
+import collections
 import functools
 import json
 from dataclasses import dataclass, field
@@ -188,11 +194,14 @@ class WallTaper:
         return self.narrowing > SHAPE_SIGNIFICANCE * self.error
 
 
-def wall_taper(c: Completion, n_visible_T: np.ndarray) -> WallTaper | None:
+def wall_taper(c: Completion, n_visible_T: np.ndarray,
+               between: tuple[float, float] = (0.0, 1.0)) -> WallTaper | None:
     """The visible side wall's narrowing upwards: the median radius (distance to the axis) of
     the wall's points (normal within WALL_NORMAL_COSINE of horizontal) in WALL_BINS height bins
     between the table and the top band, fitted by least squares against the bins' heights;
     None with fewer than three bins of WALL_MIN_POINTS points (a squat object, a hidden wall).
+    `between`: the share of the wall's height range measured, from its lowest point (0) to its
+    highest (1) — (0, 0.5) the lower half only.
 
     An open container upside down meets the table with its rim, which is (nearly always) its
     widest end: its wall narrows from the table up to the base on top. A solid standing on its
@@ -206,6 +215,11 @@ def wall_taper(c: Completion, n_visible_T: np.ndarray) -> WallTaper | None:
         return None
     z = p[:, 2]
     wall = (np.abs(n[:, 2]) < WALL_NORMAL_COSINE) & (z < z.max() - END_BAND)
+    if wall.sum() < 3 * WALL_MIN_POINTS:
+        return None
+    zw = z[wall]
+    lo, hi = zw.min() + np.multiply(between, zw.max() - zw.min())
+    wall[wall] = (zw >= lo) & (zw <= hi)
     if wall.sum() < 3 * WALL_MIN_POINTS:
         return None
     zw = z[wall]
@@ -232,6 +246,18 @@ def wall_taper(c: Completion, n_visible_T: np.ndarray) -> WallTaper | None:
     return WallTaper(narrowing=-float(slope), error=float(np.sqrt(max(chi2, 1.0) / sxx)))
 
 
+def shoulder(c: Completion, n_visible_T: np.ndarray) -> bool:
+    """The side wall is straight in its lower half and narrows in its upper half, beyond their
+    noise: a bottle's shoulder, however low it begins. An open container upside down (resting on
+    its wider rim) narrows from the table up, its lower half too; a solid keeps its width."""
+    lower = wall_taper(c, n_visible_T, (0.0, 0.5))
+    upper = wall_taper(c, n_visible_T, (0.5, 1.0))
+    if lower is None or upper is None or lower.significant:
+        return False
+    bend = upper.narrowing - lower.narrowing
+    return bend > SHAPE_SIGNIFICANCE * float(np.hypot(upper.error, lower.error))
+
+
 @dataclass(frozen=True)
 class ClosedEndModel:
     """P(upside-down | a closed end on top): a logistic regression on `ClosedEnd.features` [mm],
@@ -247,22 +273,23 @@ class ClosedEndModel:
 
 
 def closed_end_decision(model: ClosedEndModel, end: ClosedEnd, wall: WallTaper | None, *,
-                        narrower_top: bool = False) -> tuple[float, str]:
+                        narrower_top: bool = False, flat_sign: float = 1.0) -> tuple[float, str]:
     """(top sign, cue) of a closed end on top. The model reads the end's shape: a lid recessed
     below its rim says upright ("lid"). What it reads as a base must show it by more than the
     lack of a lid, since a flat closed top (a solid block's, a closed box's) looks like a flat
     base: the end is pushed in beyond its noise (a can's bottom: "base"), or the wall narrows
     from the table up (a container resting on its wider rim: "rim"). A flat end on a straight
     wall says nothing of which end is up: the end radii decide when they read the top narrower
-    than the base (`narrower_top`: the taper cue the wall did not confirm, "taper"), else
-    upright, the usual pose ("flat"; the calibrated likelihoods say how often each is wrong)."""
+    than the base (`narrower_top`: the taper cue the wall did not confirm, "taper"), else the
+    end the training views that reached this cue rested on more often (`flat_sign`:
+    `PoseCalibration.flat_sign`; "flat")."""
     if model.p_upsidedown(end) <= 0.5:
         return 1.0, "lid"
     if end.shaped:
         return -1.0, "base"
     if wall is not None and wall.significant:
         return -1.0, "rim"
-    return (-1.0, "taper") if narrower_top else (1.0, "flat")
+    return (-1.0, "taper") if narrower_top else (flat_sign, "flat")
 
 
 @dataclass(frozen=True)
@@ -280,6 +307,18 @@ class PoseCalibration:
     source: str = ""  # how the counts were made (objects, sensor, command)
     # The closed-end model (`ClosedEndModel`) fitted on the same views, or None (the cue off).
     closed_end: ClosedEndModel | None = None
+
+    @property
+    def flat_sign(self) -> float:
+        """Which end is up when a closed end on top shows no shape and nothing else tells (the
+        "flat" cue): +1 (upright) when the training views that reached the cue were upright at
+        least as often as upside-down, else −1. A flat closed end is a solid's top or a
+        container's base: the views count which our objects show; with none, upright."""
+        seen = collections.Counter()
+        for key, c in self.counts.items():
+            if key.split("/")[1] == "flat":
+                seen.update(c)
+        return 1.0 if seen["upright"] >= seen["upsidedown"] else -1.0
 
     def likelihood(self, decision: str, cue: str) -> dict[str, float]:
         """P(true pose | decision, cue), over POSES (sums to 1)."""
@@ -435,7 +474,8 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
             top_sign, cue = 1.0, "cavity"
         elif handle_end != 0:
             top_sign, cue = float(handle_end), "handle"
-        elif r_high < cfg.neck_ratio * r_low and r_mid >= cfg.neck_body_ratio * r_low:
+        elif r_high < cfg.neck_ratio * r_low and (r_mid >= cfg.neck_body_ratio * r_low
+                                                  or shoulder(c, n_visible_T)):
             top_sign, cue = 1.0, "neck"
         elif narrower_top and taper_confirmed(wall := wall_taper(c, n_visible_T)):
             top_sign, cue = -1.0, "taper"
@@ -445,7 +485,8 @@ def estimate_pose(c: Completion, n_visible_T: np.ndarray, p_TC: np.ndarray,
                 wall = wall_taper(c, n_visible_T)
             if end is not None and calibration.closed_end is not None:
                 top_sign, cue = closed_end_decision(calibration.closed_end, end, wall,
-                                                    narrower_top=narrower_top)
+                                                    narrower_top=narrower_top,
+                                                    flat_sign=calibration.flat_sign)
             elif narrower_top:
                 top_sign, cue = -1.0, "taper"
             else:
