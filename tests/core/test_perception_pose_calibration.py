@@ -92,28 +92,8 @@ def test_the_closed_end_measures_a_recessed_lid_a_flat_and_a_domed_base():
 
 def _frustum(r_table, r_top, H=0.12, top_height=None):
     """Visible points and normals of a closed frustum on the table (radius r_table at the table,
-    r_top at its flat or shaped top, `top_height(r)` [m]), its half towards +x."""
-    from types import SimpleNamespace
-
-    top_height = top_height or (lambda r: H)
-    th = np.linspace(-np.pi / 2, np.pi / 2, 60)
-    slope = (r_table - r_top) / H  # [m/m] narrowing upwards
-    zs = np.arange(0.004, H - 0.001, 0.003)
-    wall = np.array([((r_table - slope * z) * np.cos(t), (r_table - slope * z) * np.sin(t), z)
-                     for t in th for z in zs])
-    n_wall = np.array([(np.cos(t), np.sin(t), slope) for t in th for z in zs])
-    step = 0.0015
-    g = np.arange(-r_top, r_top + step, step)
-    x, y = np.meshgrid(g, g)
-    r = np.hypot(x, y)
-    top = np.c_[x[r <= r_top], y[r <= r_top], [top_height(v) for v in r[r <= r_top]]]
-    p = np.vstack([wall, top])
-    n = np.vstack([n_wall / np.linalg.norm(n_wall, axis=1, keepdims=True),
-                   np.tile([0.0, 0.0, 1.0], (len(top), 1))])
-    m = len(p)
-    c = SimpleNamespace(p_T=p, visible=np.ones(m, bool), handle=np.zeros(m, bool),
-                        p_TA=np.array([0.0, 0.0, H / 2]))
-    return c, n
+    r_top at its flat or shaped top, `top_height(r)` [m]), its half towards +x (`_revolved`)."""
+    return _revolved(lambda z: r_table - (r_table - r_top) * z / H, H, top_height)
 
 
 def test_the_wall_taper_measures_the_draft_and_a_straight_wall_has_none():
@@ -209,9 +189,10 @@ def test_only_a_flat_end_follows_the_flat_sign():
                                    flat_sign=-1.0) == (sign, name), name
 
 
-def _revolved(radius, H=0.12):
+def _revolved(radius, H=0.12, top_height=None):
     """Visible points and normals of a closed body of revolution standing on the table, its
-    radius `radius(z)` [m] at height z, a flat top; its half towards +x (as `_frustum`)."""
+    radius `radius(z)` [m] at height z, its top at the heights `top_height(r)` [m] (flat at H by
+    default); its half towards +x."""
     from types import SimpleNamespace
 
     th = np.linspace(-np.pi / 2, np.pi / 2, 60)
@@ -226,8 +207,10 @@ def _revolved(radius, H=0.12):
     step, r_top = 0.0015, radius(H)
     g = np.arange(-r_top, r_top + step, step)
     x, y = np.meshgrid(g, g)
-    inside = np.hypot(x, y) <= r_top
-    top = np.c_[x[inside], y[inside], np.full(inside.sum(), H)]
+    r = np.hypot(x, y)
+    inside = r <= r_top
+    top_height = top_height or (lambda r: H)
+    top = np.c_[x[inside], y[inside], [top_height(v) for v in r[inside]]]
     p = np.vstack([wall, top])
     n_wall = np.array(n_wall)
     n = np.vstack([n_wall / np.linalg.norm(n_wall, axis=1, keepdims=True),

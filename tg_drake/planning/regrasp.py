@@ -172,8 +172,8 @@ def second_leg_reachable(moved: ObjectDescription, parts, *, placing: TaskPlacin
     centroid = np.asarray(moved.p_W, float).mean(axis=0) if len(moved.p_W) else None
     why = ""
     for i in order[:max_grasps]:
-        if budget_spent():
-            return why or budget_reason(config)
+        if budget_spent():  # (plan_task_leg's reason names the budget)
+            return why or "not examined"
         part = PART_LABELS[int(labels[i])]
         X_WG = X_WG_all[i]
         refusal = _refusal(moved, part, X_WG, centroid, config, table_z)
