@@ -258,7 +258,7 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
     planner = builder.AddNamedSystem("planner", GraspPlanner(
         place_xy=place_xy_W, start_time=supervision.planning_start + supervision.period,
         config=config.planner, scenario=scenario, placing=placing, surfaces=surfaces,
-        handover=handover_of(scenario)))
+        handover=handover_of(scenario), feasibility=config.feasibility))
     builder.Connect(scene, planner.GetInputPort("scene_description"))
     builder.Connect(ranked, planner.GetInputPort("ranked_grasps"))
     builder.Connect(station.outputs["iiwa.state"], planner.GetInputPort("iiwa.state"))

@@ -226,6 +226,7 @@ def test_the_assessed_candidates_keep_the_scorers_score(monkeypatch):
     monkeypatch.setattr(feasibility, "grasp_feasibility", lambda X_WG, **kw: SimpleNamespace(
         reasons=["", "", "in collision with the table", ""], p_hold=np.full(len(X_WG), 0.5),
         holds=(None,) * len(X_WG)))
+    monkeypatch.setattr(feasibility, "geometric_refusal", lambda *a, **kw: "")  # (tests of pads)
     obj = ObjectDescription(
         p_W=np.zeros((10, 3)), n_W=np.zeros((10, 3)), labels=np.zeros(10, int),
         visible=np.ones(10, bool), X_WO=np.eye(4), extents=np.full(3, 0.1), pose="upright",

@@ -5,10 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from grasp_helpers import GRASP_POINT, grasp_pose, scene_with_box
+from grasp_helpers import GRASP_POINT, box_object, grasp_pose, ranked, scene_with_box
 from pydrake.math import RigidTransform, RotationMatrix
 
-from tg_drake.grasping.expansion import ExpansionConfig, retreat_above_table
 from tg_drake.planning import ik
 from tg_drake.planning.ik import (
     CONSTRAINT_TOLERANCE,
@@ -18,7 +17,6 @@ from tg_drake.planning.ik import (
     solve_ik_seeds,
 )
 from tg_drake.planning.planner import (
-    TABLE_CLEARANCE,
     PlannerConfig,
     place_pose,
     plan_pick_and_place,
@@ -26,38 +24,13 @@ from tg_drake.planning.planner import (
 from tg_drake.planning.regrasp import plan_task_leg
 from tg_drake.planning.trajectory import IIWA_VELOCITY_LIMITS
 from tg_drake.robot import IIWA_HOME, IIWA_POSITION_LIMITS, wrist_reach_margin
-from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, PartBox
+from tg_drake.types import PartBox
 
 # The IK tolerances of PlannerConfig: 2 mm per axis (so up to 2·√3 mm), 0.02 rad; plus what the
 # accepted constraint violation (ik.CONSTRAINT_TOLERANCE, 1e-5) allows: 1e-5 m, and, on the
 # orientation constraint's cosine near 0.02 rad, 1e-5 / (2 sin 0.02) ≈ 2.5e-4 rad.
 IK_POSITION_ERROR = 2e-3 * np.sqrt(3) + 1e-5
 IK_ANGLE_ERROR = 0.02 + 3e-4
-
-
-def box_object(p_W_center, extents, parts=("bottom", "middle", "top")) -> ObjectDescription:
-    """An upright box on the table, its height split evenly into the given parts (bottom up)."""
-    extents = np.asarray(extents, float)
-    X_WO = np.eye(4)
-    X_WO[:3, 3] = p_W_center
-    boxes = {}
-    for k, name in enumerate(parts):
-        X_WB = X_WO.copy()
-        X_WB[2, 3] += -extents[2] / 2 + extents[2] * (k + 0.5) / len(parts)
-        boxes[name] = PartBox(X_WB, np.array([extents[0], extents[1], extents[2] / len(parts)]) / 2)
-    return ObjectDescription(
-        p_W=np.zeros((0, 3)), n_W=np.zeros((0, 3)), labels=np.zeros(0, int),
-        visible=np.zeros(0, bool), X_WO=X_WO, extents=extents, pose="upright",
-        pose_likelihood={"upright": 1.0}, part_probabilities=dict.fromkeys(parts, 1.0),
-        part_boxes=boxes, pregrasp_X_WG=np.zeros((0, 4, 4)), pregrasp_parts=np.zeros(0, int))
-
-
-def candidates(poses_and_parts, scores=None) -> GraspCandidates:
-    X = np.array([X for X, _ in poses_and_parts])
-    parts = np.array([PART_LABELS.index(p) for _, p in poses_and_parts])
-    scores = np.linspace(0.9, 0.5, len(parts)) if scores is None else np.asarray(scores, float)
-    return GraspCandidates(X_WG=X, parts=parts, p_part=scores, p_local=np.ones(len(parts)),
-                           score=scores)
 
 
 def assert_gripper_at(arm, q, X_WG):
@@ -165,7 +138,7 @@ def test_velocity_limits_are_the_robot_facts():
 
 def test_object_out_of_reach_is_an_unreachable_result():
     far = box_object([1.6, 0.0, 0.06], [0.07, 0.07, 0.12])
-    c = candidates([(grasp_pose([1.6, 0, 0.09], [1, 0, 0], [0, 1, 0]), "middle"),
+    c = ranked([(grasp_pose([1.6, 0, 0.09], [1, 0, 0], [0, 1, 0]), "middle"),
                     (grasp_pose([1.6, 0, 0.11], [0, 0, -1], [0, 1, 0]), "top"),
                     (grasp_pose([1.6, 0, 0.11], [0, 0, -1], [1, 0, 0]), "top")])
     r = plan_pick_and_place(c, target=far, place_xy=(0.7, -0.3))
@@ -181,7 +154,7 @@ def test_object_out_of_reach_is_an_unreachable_result():
 def test_max_parts_tries_only_the_leading_part():
     """The closed loop asks for one part at a time: the leading part's candidates are all
     unreachable (they approach from under the table), the next part is not examined."""
-    c = candidates([(grasp_pose([0.75, 0.1, 0.03], [0, 0, 1], [0, 1, 0]), "bottom"),
+    c = ranked([(grasp_pose([0.75, 0.1, 0.03], [0, 0, 1], [0, 1, 0]), "bottom"),
                     (grasp_pose([0.75, 0.1, 0.03], [0, 0, 1], [1, 0, 0]), "bottom"),
                     (TOP, "top")])
     r = plan_pick_and_place(c, target=BOX, place_xy=(0.75, -0.25), max_parts=1)
@@ -196,7 +169,7 @@ def test_max_parts_tries_only_the_leading_part():
 
 
 def test_unreachable_place_is_not_a_collision_of_the_part():
-    c = candidates([(TOP, "top")])
+    c = ranked([(TOP, "top")])
     r = plan_pick_and_place(c, target=BOX, place_xy=(1.6, 0.0))
     assert r.status == "unreachable"
     assert r.unreachable_parts == ()  # the top can be picked: no collision(top) evidence
@@ -208,7 +181,7 @@ def test_unreachable_place_is_not_a_collision_of_the_part():
 
 def test_zero_scores_are_ruled_out_not_unreachable():
     """A part the logic gave probability 0 is skipped without blaming its reach."""
-    c = candidates([(SIDE, "middle"), (TOP, "top")], scores=[0.0, 0.0])
+    c = ranked([(SIDE, "middle"), (TOP, "top")], scores=[0.0, 0.0])
     r = plan_pick_and_place(c, target=BOX, place_xy=(0.75, -0.25))
     assert r.status == "unreachable"
     assert r.unreachable_parts == () and r.part_reachable == {}
@@ -218,7 +191,7 @@ def test_zero_scores_are_ruled_out_not_unreachable():
 
 def test_a_feasibility_reason_is_kept_for_a_candidate_it_ruled_out():
     """A pose the feasibility stage gave score 0 keeps its reason and says nothing about reach."""
-    c = candidates([(SIDE, "middle"), (TOP, "top")], scores=[0.0, 0.0])
+    c = ranked([(SIDE, "middle"), (TOP, "top")], scores=[0.0, 0.0])
     c.feasibility_reasons = ("would not hold: P(hold) 0.10", "collision: the left pad would cut "
                              "another object by 4.0 mm")
     r = plan_pick_and_place(c, target=BOX, place_xy=(0.75, -0.25))
@@ -242,7 +215,7 @@ PLACE_XY = (0.7, -0.3)
 
 @pytest.fixture(scope="module")
 def planned():
-    c = candidates([(SIDE, "top"), (TOP, "top")])
+    c = ranked([(SIDE, "top"), (TOP, "top")])
     return plan_pick_and_place(c, target=BOX, obstacles=[OTHER], place_xy=PLACE_XY,
                                q_start=IIWA_HOME)
 
@@ -362,302 +335,6 @@ def test_the_retreat_backs_out_along_the_approach_at_the_place():
                                    [0.6, -0.35, X_place[2, 3] + 0.02], atol=1e-9)
 
 
-# The planner's geometric refusals, kept behind the feasibility stage (measured: without them the
-# replacement lost executed grasps; see the commit message).
-
-
-def clear_of_table(X_WG, table_z):
-    """X_WG moved back above the table by the rule of the scored poses
-    (tg_drake.grasping.expansion), clearing it by the planner's TABLE_CLEARANCE."""
-    config = ExpansionConfig(table_clearance=TABLE_CLEARANCE, max_retreat=np.inf)
-    moved, ok = retreat_above_table(X_WG, table_z, approach_distance=0.0, config=config)
-    return moved[0] if ok[0] else None
-
-
-def test_part_wider_than_the_opening_is_infeasible():
-    wide = box_object([0.75, 0.1, 0.06], [0.07, 0.16, 0.12])
-    c = candidates([(grasp_pose([0.75, 0.1, 0.09], [0, 0, -1], [0, 1, 0]), "top")])
-    r = plan_pick_and_place(c, target=wide, place_xy=(0.75, -0.25))
-    assert r.status == "unreachable"
-    assert np.isinf(r.costs[0])
-    assert "across the fingers" in r.candidate_reasons[0]
-
-
-def test_a_rim_grasp_needs_only_the_wall_between_the_fingers():
-    """A bowl is wider than the WSG opens, so its top's box rules every grasp out; measured on the
-    perceived points between the pads, a grasp across the wall fits."""
-    from tg_drake.planning.planner import _part_width, _width_between_pads
-
-    angle = np.linspace(0.0, 2.0 * np.pi, 720, endpoint=False)
-    height = np.linspace(0.0, 0.06, 25)
-    ring = np.stack([np.cos(angle), np.sin(angle)], axis=1)
-    # Outer wall radius 0.08 m and inner 0.076 m, 6 cm high, centred at (0.75, 0.1) on the table.
-    p_W = np.concatenate([np.column_stack([0.75 + r * ring[:, 0], 0.1 + r * ring[:, 1],
-                                           np.full(len(ring), z)])
-                          for r in (0.08, 0.076) for z in height])
-    bowl = box_object([0.75, 0.1, 0.03], [0.16, 0.16, 0.06])
-    bowl.p_W = p_W
-    rim = grasp_pose([0.75 + 0.078, 0.1, 0.055], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
-    assert _part_width(bowl, "top", rim) == pytest.approx(0.16)
-    # The inner wall's farthest point under the 2 cm wide pads: 1 cm along the wall, where the
-    # ring has curved away from the grasp point.
-    inner = 0.078 - np.sqrt(0.076 ** 2 - 0.01 ** 2)
-    assert _width_between_pads(bowl, rim) == pytest.approx(2 * inner, abs=5e-4)
-    # Across the middle of the bowl the fingers would land on both walls: no fit, and nothing
-    # between the pads at all far from the bowl.
-    across = grasp_pose([0.75, 0.1, 0.055], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
-    assert _width_between_pads(bowl, across) > PlannerConfig().open_width
-    away = grasp_pose([0.5, -0.2, 0.055], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
-    assert _width_between_pads(bowl, away) == np.inf
-
-
-def test_fingers_do_not_close_along_a_long_part():
-    from tg_drake.planning.planner import _closes_along_length
-
-    knife = box_object([0.75, 0.0, 0.01], [0.02, 0.09, 0.02], parts=("handle",))
-    along = grasp_pose([0.75, 0.0, 0.01], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
-    across = grasp_pose([0.75, 0.0, 0.01], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
-    assert "along the 0.090 m length of handle" in _closes_along_length(
-        knife, "handle", along, PlannerConfig())
-    assert _closes_along_length(knife, "handle", across, PlannerConfig()) == ""
-    cube = box_object([0.75, 0.0, 0.03], [0.06, 0.06, 0.06], parts=("middle",))
-    assert _closes_along_length(cube, "middle", along, PlannerConfig()) == ""
-
-
-def test_a_part_too_flat_for_the_pads_above_the_table_is_refused():
-    from tg_drake.planning.planner import TABLE_CLEARANCE, _depth_between_pads
-
-    def plate(thickness):
-        g = np.linspace(-0.03, 0.03, 31)
-        x, y, z = np.meshgrid(g, g, np.linspace(0.0, thickness, 4))
-        o = box_object([0.75, 0.0, thickness / 2], [0.06, 0.06, thickness], parts=("middle",))
-        o.p_W = np.column_stack([0.75 + x.ravel(), y.ravel(), z.ravel()])
-        return o
-
-    OPEN = PlannerConfig().open_width
-    X = clear_of_table(grasp_pose([0.75, 0.0, 0.0], approach_W=[0, 0, -1],
-                                  closing_W=[0, 1, 0]), 0.0)
-    # The pads' tips stay TABLE_CLEARANCE above the table: a plate reaches (thickness −
-    # clearance) between them.
-    for thickness in (0.012, 0.03):
-        assert _depth_between_pads(plate(thickness), X, OPEN) == pytest.approx(
-            thickness - TABLE_CLEARANCE, abs=1e-9)
-    assert _depth_between_pads(plate(0.01), X, OPEN) < PlannerConfig().min_pad_depth
-    assert _depth_between_pads(plate(0.012), X, OPEN) > PlannerConfig().min_pad_depth
-    # Completion mirrored a 6 mm blade up to 18 mm: the points the camera saw decide.
-    blade = plate(0.018)
-    blade.visible = blade.p_W[:, 2] <= 0.006 + 1e-9
-    assert _depth_between_pads(blade, X, OPEN) == pytest.approx(0.006 - TABLE_CLEARANCE, abs=1e-9)
-    # Seen points near the grasp but none between the pads (a blade lying below the pads' tips,
-    # completion mirrored upwards): nothing the camera saw reaches between them.
-    low = plate(0.018)
-    low.visible = low.p_W[:, 2] <= 0.002 + 1e-9
-    assert _depth_between_pads(low, X, OPEN) == 0.0
-
-
-def test_a_thin_edge_pinched_in_a_side_grasp_is_refused():
-    from tg_drake.planning.planner import _overlap_across_pads, _refusal
-
-    def blade(height, z0=0.02):
-        # A vertical plate 6 cm long, 2 mm thick, `height` tall, its bottom at z0.
-        g = np.linspace(-0.03, 0.03, 31)
-        x, y, z = np.meshgrid(g, np.linspace(-0.001, 0.001, 3), np.linspace(0, height, 61))
-        o = box_object([0.75, 0.0, z0 + height / 2], [0.06, 0.002, height], parts=("middle",))
-        o.p_W = np.column_stack([0.75 + x.ravel(), y.ravel(), z0 + z.ravel()])
-        return o
-
-    config = PlannerConfig()
-    # A side grasp closing across the plate's thickness, the pads' 20 mm width vertical.
-    X = grasp_pose([0.75, 0.0, 0.03], approach_W=[1, 0, 0], closing_W=[0, 1, 0])
-    assert _overlap_across_pads(blade(0.03, 0.015), X, config.open_width) == pytest.approx(
-        0.02, abs=1e-3)  # the plate covers the pads' whole width
-    edge = blade(0.002, 0.029)
-    assert _overlap_across_pads(edge, X, config.open_width) == pytest.approx(0.002, abs=1e-9)
-    assert "thin edge" in _refusal(edge, "middle", X, None, config)
-    assert _refusal(blade(0.03, 0.015), "middle", X, None, config) == ""
-
-
-def test_a_tool_pressed_only_above_its_widest_section_is_refused():
-    from tg_drake.planning.planner import _pad_area_below_middle, _refusal
-
-    # A handle lying on the table along x: 10 cm long, 20 mm wide, 16 mm tall (knife_03's as
-    # perceived), its top and its sides down to 4 mm seen.
-    g = np.linspace(0.70, 0.80, 51)
-    top = np.stack(np.meshgrid(g, np.linspace(-0.01, 0.01, 11), [0.016]), -1).reshape(-1, 3)
-    sides = np.stack(np.meshgrid(g, [-0.01, 0.01], np.linspace(0.004, 0.016, 7)), -1).reshape(-1, 3)
-    handle = box_object([0.75, 0.0, 0.008], [0.10, 0.02, 0.016], parts=("handle",))
-    handle.p_W = np.concatenate([top, sides])
-    handle.visible = np.ones(len(handle.p_W), bool)
-    handle.is_tool = True
-    config = PlannerConfig()
-    OPEN = config.open_width
-    # Straight down across it, the pads' tips 4 mm above the table: their faces cover its lower
-    # half (4 to 8 mm) over their 20 mm width.
-    down = clear_of_table(grasp_pose([0.75, 0.0, 0.0], approach_W=[0, 0, -1],
-                                     closing_W=[0, 1, 0]), 0.0)
-    assert _pad_area_below_middle(handle, down, OPEN, 0.0) == pytest.approx(80e-6, rel=0.05)
-    assert _refusal(handle, "handle", down, None, config) == ""
-    # End-on along it, the approach tilted 35° down to clear the table: only the corner at the
-    # pads' tips reaches below its middle (a triangle of about 4² / (2 sin 35° cos 35°) mm²).
-    s, c = np.sin(np.deg2rad(35.0)), np.cos(np.deg2rad(35.0))
-    end_on = clear_of_table(grasp_pose([0.73, 0.0, 0.008], approach_W=[c, 0, -s],
-                                       closing_W=[0, 1, 0]), 0.0)
-    assert _pad_area_below_middle(handle, end_on, OPEN, 0.0) == pytest.approx(17e-6, rel=0.15)
-    assert "lower half" in _refusal(handle, "handle", end_on, None, config)
-    # The rule is the tools': a container's wall or handle is not rounded about a middle height
-    # (the other checks pass this grasp).
-    handle.is_tool = False
-    assert _refusal(handle, "handle", end_on, None, config) == ""
-
-
-def test_torsion_lever_is_the_weight_arm_about_the_closing_axis():
-    from tg_drake.planning.planner import torsion_lever
-
-    # Top-down across a handle along world x (fingers closing along y): a weight 0.1 m further
-    # along the handle turns the object about the closing axis with a 0.1 m lever.
-    X = grasp_pose([0.7, 0.0, 0.02], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
-    assert torsion_lever(X, [0.8, 0.0, 0.02]) == pytest.approx(0.1, abs=1e-12)
-    # A weight along the closing axis (a rim grasp: the pan's middle beyond the wall), or
-    # straight below, presses on the pads' faces instead: no lever about the closing axis.
-    assert torsion_lever(X, [0.7, 0.1, 0.02]) == pytest.approx(0.0, abs=1e-12)
-    assert torsion_lever(X, [0.7, 0.0, -0.1]) == pytest.approx(0.0, abs=1e-12)
-
-
-def test_an_object_past_both_pads_is_refused_one_past_a_single_pad_is_not():
-    from tg_drake.planning.planner import _extent_along_closing, _refusal
-
-    config = PlannerConfig()
-    half = (config.open_width - config.release_gap) / 2
-    X = grasp_pose([0.7, 0.0, 0.03], approach_W=[0, 0, -1], closing_W=[1, 0, 0])
-    # A can lying along x, 113 mm long, taken at its middle with the fingers along its axis.
-    can = box_object([0.7, 0.0, 0.03], [0.113, 0.055, 0.055], parts=("middle",))
-    t = np.linspace(0, 2 * np.pi, 24, endpoint=False)
-    xs = np.linspace(-0.0565, 0.0565, 30)
-    can.p_W = np.array([[0.7 + x, 0.0275 * np.cos(a), 0.03 + 0.0275 * np.sin(a)]
-                        for x in xs for a in t])
-    lo, hi = _extent_along_closing(can, X, config.release_band)
-    assert (lo, hi) == pytest.approx((-0.0565, 0.0565), abs=1e-9)
-    assert -lo > half and hi > half
-    # A shorter one, 102 mm (can_03 as perceived), its middle part a 34 mm band that fits the
-    # opening: 4 mm a side at the release kept it wedged in simulation.
-    short = box_object([0.7, 0.0, 0.03], [0.034, 0.055, 0.055], parts=("middle",))
-    short.p_W = np.array([[0.7 + x, 0.0275 * np.cos(a), 0.03 + 0.0275 * np.sin(a)]
-                          for x in np.linspace(-0.051, 0.051, 27) for a in t])
-    assert "could not let go" in _refusal(short, "middle", X, None, config)
-    # A cup's handle reaching past one pad only: the fingers open clear of the other side.
-    cup = box_object([0.7, 0.0, 0.03], [0.105, 0.075, 0.06], parts=("middle",))
-    cup.p_W = can.p_W[np.abs(can.p_W[:, 0] - 0.7) <= 0.0375] + [0.0, 0.0, 0.0]
-    cup.p_W = np.vstack([cup.p_W, [[0.7 + 0.0675, 0.0, 0.03]]])  # the handle's far end
-    lo, hi = _extent_along_closing(cup, X, config.release_band)
-    assert hi > half and not -lo > half
-    # A lying cup taken across its body, 46 mm on the near side and its handle out to 73 mm
-    # on the far one (cup_04 as perceived): let go in simulation.
-    body = np.array([[0.7 + x, 0.0275 * np.cos(a), 0.03 + 0.0275 * np.sin(a)]
-                     for x in np.linspace(-0.046, 0.046, 24) for a in t])
-    cup.p_W = np.vstack([body, [[0.7 + x, 0.0, 0.03] for x in np.linspace(0.046, 0.073, 8)]])
-    lo, hi = _extent_along_closing(cup, X, config.release_band)
-    assert -lo < half < hi
-
-
-def test_a_grasp_far_from_the_weight_across_the_lever_is_refused():
-    # A pan-like object: its points (and centroid) around (0.7, 0, 0.03); a handle grasp 0.2 m
-    # out along x, the fingers closing along y: the weight turns it about the closing axis with
-    # a 0.2 m lever, which the pads resist by friction alone.
-    pan = box_object([0.9, 0.0, 0.03], [0.12, 0.03, 0.03], parts=("handle",))
-    t = np.linspace(0, 2 * np.pi, 60, endpoint=False)
-    r = np.linspace(0.0, 0.12, 8)
-    body = np.array([[0.7 + ri * np.cos(a), ri * np.sin(a), 0.03] for ri in r for a in t])
-    handle = np.array([[x, y, 0.03] for x in np.linspace(0.84, 0.96, 13) for y in (-0.01, 0.01)])
-    pan.p_W = np.vstack([body, np.tile(body[-60:], (4, 1)), handle])  # centroid near the middle
-    far = grasp_pose([0.9, 0.0, 0.03], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
-    result = plan_pick_and_place(candidates([(far, "handle")], [0.9]), target=pan,
-                                 place_xy=[0.5, -0.3])
-    assert result.status == "unreachable"
-    assert "m lever (at most 0.12 m)" in result.candidate_reasons[0]
-
-
-def test_a_step_under_the_pads_is_refused():
-    from tg_drake.planning.planner import _contact_share, _refusal
-
-    config = PlannerConfig()
-    # A top-down grasp closing along y over a horizontal 6 mm rod along x (the pads' width),
-    # 20 mm above the table; with a 20 mm wide block where one pad edge lands, a step.
-    X = grasp_pose([0.75, 0.0, 0.02], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
-
-    def rod(block: bool):
-        g = np.linspace(-0.03, 0.03, 61)
-        a = np.linspace(0, 2 * np.pi, 24, endpoint=False)
-        x, t = np.meshgrid(g, a)
-        p = np.column_stack([0.75 + x.ravel(), 0.003 * np.cos(t.ravel()),
-                             0.02 + 0.003 * np.sin(t.ravel())])
-        if block:  # x from 0.75 − 0.012 back: y ±10 mm
-            b = np.linspace(-0.01, 0.01, 21)
-            bx, by, bz = np.meshgrid(np.linspace(0.72, 0.742, 12), b, np.linspace(0.01, 0.03, 11))
-            p = np.vstack([p, np.column_stack([bx.ravel(), by.ravel(), bz.ravel()])])
-        o = box_object([0.75, 0.0, 0.02], [0.06, 0.006, 0.006], parts=("middle",))
-        o.p_W = p
-        return o
-
-    assert _contact_share(rod(False), X, config.open_width) == 1.0
-    # A handle running past one pad in one band (a cup's): the pad goes beside it there.
-    handled = rod(False)
-    h = np.linspace(0.0, 0.06, 31)
-    handled.p_W = np.vstack([handled.p_W, np.column_stack([np.full(31, 0.758), h,
-                                                           np.full(31, 0.02)])])
-    assert _contact_share(handled, X, config.open_width) == 1.0
-    stepped = rod(True)
-    assert _contact_share(stepped, X, config.open_width) == pytest.approx(0.25)
-    assert "step or taper" in _refusal(stepped, "middle", X, None, config)
-    assert _refusal(rod(False), "middle", X, None, config) == ""
-
-
-def test_a_thin_tool_shaft_is_refused():
-    from tg_drake.planning.planner import _refusal
-
-    def bar(width):
-        # A tool's bar along x on the table, `width` across, 16 mm tall, its top and sides seen.
-        g = np.linspace(0.70, 0.80, 51)
-        top = np.stack(np.meshgrid(g, np.linspace(-width / 2, width / 2, 5), [0.016]),
-                       -1).reshape(-1, 3)
-        sides = np.stack(np.meshgrid(g, [-width / 2, width / 2], np.linspace(0.0, 0.016, 9)),
-                         -1).reshape(-1, 3)
-        o = box_object([0.75, 0.0, 0.008], [0.10, width, 0.016], parts=("handle",))
-        o.p_W = np.concatenate([top, sides])
-        o.visible = np.ones(len(o.p_W), bool)
-        o.is_tool = True
-        return o
-
-    config = PlannerConfig()
-    down = clear_of_table(grasp_pose([0.75, 0.0, 0.0], approach_W=[0, 0, -1],
-                                     closing_W=[0, 1, 0]), 0.0)
-    assert "thin shaft" in _refusal(bar(0.006), "handle", down, None, config)
-    assert _refusal(bar(0.012), "handle", down, None, config) == ""
-
-
-def test_an_open_pad_coming_down_on_the_object_is_refused():
-    from tg_drake.planning.planner import _open_pad_cover, _refusal
-
-    config = PlannerConfig()
-    # A top-down grasp closing along y over a 30 mm block (a hammer's head); a 25 mm bar (its
-    # handle) runs from it along y under where the right pad comes down (y 55 to 67 mm).
-    X = grasp_pose([0.75, 0.0, 0.02], approach_W=[0, 0, -1], closing_W=[0, 1, 0])
-    g = np.linspace(-0.015, 0.015, 16)
-    head = np.stack(np.meshgrid(g, g, [0.035]), -1).reshape(-1, 3) + [0.75, 0.0, 0.0]
-    bar = np.stack(np.meshgrid(np.linspace(-0.0125, 0.0125, 7), np.linspace(0.015, 0.1, 44),
-                               [0.025]), -1).reshape(-1, 3) + [0.75, 0.0, 0.0]
-    o = box_object([0.75, 0.0, 0.0175], [0.03, 0.03, 0.035], parts=("usable_area",))
-    o.p_W = head
-    assert _open_pad_cover(o, X, config.open_width) == 0.0
-    o.p_W = np.vstack([head, bar])
-    assert _open_pad_cover(o, X, config.open_width) > config.max_pad_cover
-    o.is_tool = True
-    assert "come down on the object" in _refusal(o, "usable_area", X, None, config)
-    # A container's wall or handle under a pad yields (a cup's handle did, and the grasp held):
-    # the check is for tools lying on the table only.
-    o.is_tool = False
-    assert "come down on the object" not in _refusal(o, "usable_area", X, None, config)
-
-
 def test_a_straight_move_onto_another_ik_branch_has_its_start_solved_again(monkeypatch):
     """The grasp's IK (seeded by the pre-grasp's) lands on a flipped wrist: the pre-grasp is
     solved again from the grasp's configuration, so the 10 cm approach is not a wrist flip."""
@@ -739,7 +416,7 @@ def test_a_plan_request_stops_where_its_ik_budget_runs_out():
     a budget all are examined; with a budget of one solve the request ends after the first
     candidate's pick and says why."""
     scene = scene_with_box([0.75, 0.1, 0.10])
-    c = candidates([(SIDE, "top"), (TOP, "top"), (SIDE, "middle")])
+    c = ranked([(SIDE, "top"), (TOP, "top"), (SIDE, "middle")])
     far = (0.0, -1.2)  # [m] beyond the arm's reach
     free = plan_task_leg(scene, c, place_xy=far, q_start=IIWA_HOME,
                          config=PlannerConfig(max_ik_solves=None))
@@ -755,7 +432,7 @@ def test_a_plan_request_stops_where_its_ik_budget_runs_out():
 
 def test_a_budget_that_suffices_leaves_the_plan_as_it_is():
     scene = scene_with_box([0.75, 0.1, 0.10])
-    c = candidates([(SIDE, "top"), (TOP, "top")])
+    c = ranked([(SIDE, "top"), (TOP, "top")])
     plans = [plan_task_leg(scene, c, place_xy=PLACE_XY, q_start=IIWA_HOME,
                            config=PlannerConfig(max_ik_solves=n)) for n in (None, 10_000)]
     assert [r.status for r in plans] == ["planned", "planned"]

@@ -112,6 +112,7 @@ def test_every_stage_config_is_settable_from_yaml(tmp_path):
     config: {completion: {sigma: 0.8}, segmentation: {seed: 3}}
   prior: {n_neighbours: 5}
   logic: {category: general, grasp: general, use_prior: false, prior_floor: 0.1}
+  feasibility: {max_torsion_lever: 0.1, min_pad_depth: 0.005}
   planner: {lift_height: 0.2, place_yaws: [0, 90], carry_limits: {velocity_scale: 0.3}}
 """).pipeline
     assert p.perception.config.completion.sigma == 0.8
@@ -119,6 +120,7 @@ def test_every_stage_config_is_settable_from_yaml(tmp_path):
     assert p.prior.n_neighbours == 5
     assert (p.logic.category, p.logic.grasp, p.logic.use_prior, p.logic.prior_floor) == (
         "general", "general", False, 0.1)
+    assert (p.feasibility.max_torsion_lever, p.feasibility.min_pad_depth) == (0.1, 0.005)
     assert p.planner.lift_height == 0.2 and p.planner.place_yaws == [0, 90]
     assert p.planner.carry_limits.velocity_scale == 0.3
     assert p.planner.carry_limits.min_duration == 1.0  # the nested default is kept
@@ -147,6 +149,8 @@ def test_the_resolved_scenario_round_trips_through_yaml(tmp_path):
      "unknown grasp model variant 'specfic'; allowed: specific, general, learned"),
     ("pipeline:\n  scoring: !OnePart {part: lid}\n", "pipeline.scoring.part",
      "unknown part 'lid'; allowed: top"),
+    ("pipeline:\n  feasibility: {max_pad_cover: 1.5}\n", "pipeline.feasibility.max_pad_cover",
+     "max_pad_cover must be in [0, 1], got 1.5"),
     ("pipeline:\n  category_theory: general\n", "pipeline.category_theory",
      "unknown field 'category_theory'; allowed: perception, prior, logic, scoring, feasibility"),
 ])

@@ -29,6 +29,13 @@ fingers close along ±x_G, approach along +y_G, z_G across the pads):
 (c) P(hold | features) — a logistic regression on the margins and patch features, fitted on
     physics episodes of training objects (tools/fit_hold_model.py; tg_drake/data/hold_model.json),
     the squeeze among its inputs; reported, and ranked by with `rank_by_hold`.
+(d) geometric refusals — what lies between the open pads, measured on the perceived points
+    (`tg_drake.grasping.pads.geometric_refusal`): a part or object that does not fit the opening
+    or could not be let go, an open pad coming down on a tool, and grasps that would slip (closing
+    along a long part, too little between the pads, a step under them, a tool pressed above its
+    widest section or too thin, too long a lever for the weight). Each reason begins with its
+    class (`pads.DOES_NOT_FIT`, `COLLISION`, `WOULD_NOT_HOLD`); a part none of whose poses would
+    hold is told to the logic as no_hold(Part), not as unreachable.
 
 Arrays in, arrays out: no Drake.
 """
@@ -44,6 +51,11 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from tg_drake.errors import ModelError, ScenarioError
+from tg_drake.grasping.pads import (
+    COLLISION,
+    WOULD_NOT_HOLD,
+    geometric_refusal,
+)
 from tg_drake.robot import (
     WSG_BODY_CENTRE_G,
     WSG_BODY_SIZE,
@@ -57,7 +69,6 @@ from tg_drake.robot import (
 from tg_drake.types import CATEGORIES, PART_LABELS, GraspCandidates, SceneDescription
 
 GRAVITY = 9.81  # [m/s²]
-GRASP_DEPTH = float(WSG_GRASP_POINT_G[1])  # [m] the grasp point lies this far along +y_G.
 HOLD_MODEL = "hold_model.json"  # in tg_drake/data: the shipped fit (tools/fit_hold_model.py)
 
 
@@ -93,13 +104,48 @@ class FeasibilityConfig:
     # suites by +2 placed of 161 training runs and −1 of 93 held out, and refused the middle of
     # the paper's Fig. 1 cup for a pass (P(hold) 0.49; taken by the handle) where the middle
     # holds: reported (result.json grasp.p_hold), not acted on.
+    # The geometric refusals (`tg_drake.grasping.pads.geometric_refusal`): each compares a
+    # measure of the perceived points between the pads with one of these limits. They were
+    # set from executed grasps, not fitted; the opening is `opening`.
+    width_margin: float = 0.01  # [m] a part must be this much narrower than the opening.
+    release_gap: float = 0.013  # [m] an object reaching past both open pads, less this gap
+    # (within `release_band` of the grasp point across the pads), could not be let go.
+    release_band: float = 0.03  # [m]
+    min_pad_depth: float = 0.007  # [m] how far along the pads (the approach) the object must
+    # reach between them (seen points).
+    min_pad_overlap: float = 0.005  # [m] how far across the pads' 20 mm width the object must
+    # span between them: a thin edge pinched between the pads slides out.
+    min_contact_share: float = 0.5  # the pads must touch the object's widest section over at
+    # least this share of the bands (pads.PAD_BANDS across their width) the object fills between
+    # them: a pad landing on a step touches the step only and squeezes the object out.
+    min_tool_grip_area: float = 25e-6  # [m²] how much of a pad's face must lie over the lower
+    # half of a tool lying on the table (`pads.pad_area_below_middle`): pads pressing only above a
+    # rounded handle's widest section squeeze it down and ride up over it.
+    min_tool_grip_width: float = 0.008  # [m] a tool lying on the table is at least this thick
+    # along the closing axis between the pads (seen points): a thinner shaft rolls out.
+    max_pad_cover: float = 1.0 / 3.0  # an open pad may come down over a tool lying on the table
+    # on at most this share of its cross-section (`pads.open_pad_cover`): the pad stops on it.
+    max_torsion_lever: float = 0.12  # [m] a candidate whose `torsion_lever` (the weight's lever
+    # about the closing axis) is longer is refused: the pads resist that turn by friction alone.
+    max_length_ratio: float = 2.0  # fingers do not close along a part's length when it is this
+    # many times longer than its other extents (squeezed end to end, it slips out).
     model: str = ""  # a hold-model JSON file (tools/fit_hold_model.py); "" = the shipped one.
 
     def validate(self, where: str = "feasibility") -> None:
         for name in ("opening", "grip_force", "contact_depth", "patch_cell", "pad_friction",
-                     "object_friction", "default_density"):
+                     "object_friction", "default_density", "max_length_ratio"):
             if not getattr(self, name) > 0:
                 raise ScenarioError(f"{name} must be > 0, got {getattr(self, name)}",
+                                    field=f"{where}.{name}")
+        for name in ("width_margin", "release_gap", "release_band", "min_pad_depth",
+                     "min_pad_overlap", "min_tool_grip_area", "min_tool_grip_width",
+                     "max_torsion_lever"):
+            if not getattr(self, name) >= 0:
+                raise ScenarioError(f"{name} must be >= 0, got {getattr(self, name)}",
+                                    field=f"{where}.{name}")
+        for name in ("min_contact_share", "max_pad_cover"):
+            if not 0.0 <= getattr(self, name) <= 1.0:
+                raise ScenarioError(f"{name} must be in [0, 1], got {getattr(self, name)}",
                                     field=f"{where}.{name}")
         if not 0.0 <= self.min_p_hold <= 1.0:
             raise ScenarioError(f"min_p_hold must be in [0, 1], got {self.min_p_hold}",
@@ -505,9 +551,9 @@ def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: n
         holds.append(h)
         hits.append(c)
         if not c.free:
-            reasons.append(f"collision: the {c.box} would cut another object by "
+            reasons.append(f"{COLLISION}the {c.box} would cut another object by "
                            f"{c.depth * 1000:.1f} mm" if c.what == "other object" else
-                           f"collision: the gripper would reach {-c.table_clearance * 1000:.1f} "
+                           f"{COLLISION}the gripper would reach {-c.table_clearance * 1000:.1f} "
                            "mm under the table top")
             p.append(0.0)
             continue
@@ -517,14 +563,14 @@ def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: n
             continue
         if h.squeeze >= 1.0:  # the contact force outside the friction cone: no weight holds
             lean, cone = np.degrees(np.arctan([h.squeeze * config.friction, config.friction]))
-            reasons.append(f"would not hold: the grip squeezes it out (its surface under the "
+            reasons.append(f"{WOULD_NOT_HOLD}the grip squeezes it out (its surface under the "
                            f"pads leans {lean:.0f}° from their push; friction holds {cone:.0f}°)")
             p.append(0.0)
             continue
         ph = float(model.predict_proba(h.features())[0])
         p.append(ph)
         reasons.append("" if ph >= config.min_p_hold or not config.rank_by_hold else
-                       f"would not hold: P(hold) {ph:.2f} (margin {h.margin:.2f}, patch "
+                       f"{WOULD_NOT_HOLD}P(hold) {ph:.2f} (margin {h.margin:.2f}, patch "
                        f"{h.patch_area * 1e6:.0f} mm², lever {h.lever * 1000:.0f} mm, "
                        f"mass {h.mass:.2f} kg)")
     return Feasibility(np.array(p), tuple(reasons), tuple(holds), tuple(hits))
@@ -560,10 +606,17 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
     p_part = np.asarray(candidates.p_part, float)
     p_local = np.asarray(candidates.p_local, float)
     parts = np.asarray(candidates.parts, int)
-    ok = np.array([not r for r in f.reasons], bool)
     # The scorer's score (P(part | task) · P(grasp | local shape) for the pipeline; the Local,
     # one-part and random-part variants score otherwise), pose by pose.
     scored = np.asarray(candidates.score, float)
+    # The geometric refusals, on the poses the scorer allows that are clear and would hold so far.
+    reasons = list(f.reasons)
+    centroid = np.asarray(target.p_W, float).mean(axis=0) if len(target.p_W) else None
+    for j in np.flatnonzero(scored > 0):
+        if not reasons[j]:
+            reasons[j] = geometric_refusal(target, PART_LABELS[parts[j]], X_WG[j], centroid,
+                                           config, table_z)
+    ok = np.array([not r for r in reasons], bool)
     score = np.where(ok, scored * (f.p_hold if config.rank_by_hold else 1.0), 0.0)
     order = np.argsort(-score, kind="stable")
     # Parts the scorer allows, none of whose poses would hold (not for collisions).
@@ -571,10 +624,10 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
     unholdable = tuple(
         PART_LABELS[k] for k in np.unique(parts[viable])
         if not ok[viable & (parts == k)].any()
-        and any(f.reasons[j].startswith("would not hold")
+        and any(reasons[j].startswith(WOULD_NOT_HOLD)
                 for j in np.flatnonzero(viable & (parts == k))))
     return GraspCandidates(X_WG[order], parts[order], p_part[order], p_local[order],
                            score[order], candidates.target, p_hold=f.p_hold[order],
-                           feasibility_reasons=tuple(f.reasons[j] for j in order),
+                           feasibility_reasons=tuple(reasons[j] for j in order),
                            source=source[order], unholdable_parts=unholdable,
                            holds=tuple(f.holds[j] for j in order))

@@ -54,13 +54,13 @@ import numpy as np
 
 from tg_drake.errors import ScenarioError
 from tg_drake.grasping.feasibility import (
-    GRASP_DEPTH,
     FeasibilityConfig,
     closing_sweep,
     grasp_feasibility,
     grip_width,
     gripper_boxes,
 )
+from tg_drake.grasping.pads import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.robot import WSG_GRASP_POINT_G, WSG_MAX_OPENING, WSG_PAD_SIZE, wrist_reach_margin
 from tg_drake.tasks.judge import PASS_HOLD_DURATION
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription

@@ -7,9 +7,9 @@
 
 Candidates are tried best first (paper section VI: the pre-grasp hypotheses are pruned "by a
 collision checker and the motion trajectory planner"), each pose as given: the feasibility stage
-(tg_drake.grasping.feasibility) has made the approach variants and scored them with P(hold). The
-geometric refusals of `_refusal` still stand behind it (measured: without them executed grasps
-were lost that they had kept), and rule a pose out before any IK. For a candidate grasp pose X_WG
+(tg_drake.grasping.feasibility) has judged every pose — collisions, P(hold) and the geometric
+refusals of `tg_drake.grasping.pads` — and a pose it ruled out has score 0 and is not tried. The
+planner accepts or refuses grasps by reach alone. For a candidate grasp pose X_WG
 (gripper frame G: fingers close along ±x_G, approach along +y_G) the planner needs
 inverse-kinematics solutions, inside the joint limits and clear of collisions, for
 
@@ -50,7 +50,6 @@ from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.errors import ScenarioError
-from tg_drake.grasping.feasibility import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.logic.receive import receiver_parts
 from tg_drake.planning.handover import (
     Handover,
@@ -82,10 +81,7 @@ from tg_drake.planning.trajectory import (
 )
 from tg_drake.robot import (
     IIWA_HOME,
-    WSG_FINGERTIP_Y,
     WSG_MAX_OPENING,
-    WSG_PAD_SIZE,
-    WSG_PALM_Y,
 )
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, SceneDescription
 
@@ -111,12 +107,6 @@ class PlannerConfig:
     squeeze_duration: float = 0.1  # [s] 0 → closed_width, after the fingers have closed
     # slowly (open → 0 over close_duration) so that they meet a light object gently; and back
     # closed_width → 0 at release, before opening over open_duration.
-    # The geometric refusals (`_refusal`), behind the feasibility stage: each says what it
-    # measures on the perceived points; the numbers were set from executed grasps, not fitted.
-    width_margin: float = 0.01  # [m] a part must be this much narrower than the opening.
-    release_gap: float = 0.013  # [m] an object reaching past both open pads, less this gap
-    # (within `release_band` of the grasp point across the pads), could not be let go.
-    release_band: float = 0.03  # [m]
     close_duration: float = 0.8  # [s] opening → closed command ramp (scripted.py's timing).
     settle_duration: float = 0.4  # [s] hold after closing, before lifting.
     open_duration: float = 0.5  # [s] closed → open at release.
@@ -131,24 +121,6 @@ class PlannerConfig:
         [0.0, 0.3, 0.0, -1.6, 0.0, -1.0, 0.0],  # wrist flipped
         [0.0, 0.2, 0.0, -1.0, 0.0, 1.6, 0.0],  # from above
     ])  # [rad] IK seeds; each is also tried with joint 1 turned towards the target.
-    min_pad_depth: float = 0.007  # [m] how far along the pads (the approach) the object must
-    # reach between them (seen points).
-    min_pad_overlap: float = 0.005  # [m] how far across the pads' 20 mm width the object must
-    # span between them: a thin edge pinched between the pads slides out.
-    min_contact_share: float = 0.5  # the pads must touch the object's widest section over at
-    # least this share of the bands (PAD_BANDS across their width) the object fills between them:
-    # a pad landing on a step touches the step only and squeezes the object out.
-    min_tool_grip_area: float = 25e-6  # [m²] how much of a pad's face must lie over the lower
-    # half of a tool lying on the table (`_pad_area_below_middle`): pads pressing only above a
-    # rounded handle's widest section squeeze it down and ride up over it.
-    min_tool_grip_width: float = 0.008  # [m] a tool lying on the table is at least this thick
-    # along the closing axis between the pads (seen points): a thinner shaft rolls out.
-    max_pad_cover: float = 1.0 / 3.0  # an open pad may come down over a tool lying on the table
-    # on at most this share of its cross-section (`_open_pad_cover`): the pad stops on it.
-    max_torsion_lever: float = 0.12  # [m] a candidate whose `torsion_lever` (the weight's lever
-    # about the closing axis) is longer is refused: the pads resist that turn by friction alone.
-    max_length_ratio: float = 2.0  # fingers do not close along a part's length when it is this
-    # many times longer than its other extents (squeezed end to end, it slips out).
     place_yaws: list[float] = field(  # [deg] turns of the object
         default_factory=lambda: [0.0, 60.0, -60.0, 120.0, -120.0, 180.0])
     # about the vertical tried at the place, in order (the first one that can be planned).
@@ -349,7 +321,6 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
     bearing = float(np.arctan2(X_WO[1, 3], X_WO[0, 3]))
     seeds = _seeds(q_start, config.seed_postures, bearing)
 
-    centroid = np.asarray(target.p_W, float).mean(axis=0) if len(target.p_W) else None
     receiver_cache: dict = {}  # a pass: the receiver's feasibility per robot grasp
     tried: dict[str, set] = {name: set() for name in parts_order}
     plan = None
@@ -364,10 +335,6 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         part_reachable.setdefault(part, False)
         part_pickable.setdefault(part, False)
         X_WG = np.asarray(candidates.X_WG[i], float)
-        refusal = _refusal(target, part, X_WG, centroid, config, table_z)
-        if refusal:
-            costs[i], reasons[i] = np.inf, refusal
-            continue
         found = False
         places = _task_place_variants(X_WO_place, config, placing=placing, X_WO=X_WO,
                                       X_WG=X_WG, extents=target.extents, is_tool=target.is_tool)
@@ -547,14 +514,6 @@ def target_name(target: ObjectDescription) -> str:
     return target.name or "the object"
 
 
-# The open finger pads in G (tg_drake.robot: pads 0.012 × 0.082 × 0.02 m centred 0.055 m along
-# +y_G, inner faces at x = ±0.055 when open): the 8 outer corners of the pair [m].
-PAD_CORNERS_G = np.array([[sx * x, y, sz * WSG_PAD_SIZE[2] / 2] for sx in (-1, 1)
-                          for x in (WSG_MAX_OPENING / 2 + WSG_PAD_SIZE[0],)
-                          for y in (WSG_PALM_Y, WSG_FINGERTIP_Y) for sz in (-1, 1)])
-TABLE_CLEARANCE = 0.004  # [m] the open pads' lowest corner above the table top
-
-
 ROUND_RATIO = 0.85  # a part box whose two cross extents agree this well is taken as round
 
 
@@ -668,265 +627,6 @@ def _seeds(q_start, postures, bearing) -> list[np.ndarray]:
         if not any(np.allclose(q, u) for u in unique):
             unique.append(q)
     return unique
-
-
-def _part_width(target: ObjectDescription, part: str, X_WG: np.ndarray) -> float:
-    """Width [m] of the part's box along the closing direction x_G (0 when no box is known)."""
-    box = target.part_boxes.get(part)
-    if box is None:
-        return 0.0
-    x_B = np.asarray(box.X_WB)[:3, :3].T @ X_WG[:3, 0]
-    return float(2.0 * np.abs(x_B) @ np.asarray(box.half_extents))
-
-
-def _slab_points(target: ObjectDescription, X_WG: np.ndarray, *, reach: float,
-                 visible_only: bool = False, band: float | None = None) -> np.ndarray:
-    """The target's perceived points in G in the slab the open finger pads sweep: along the
-    approach over the pads' length, across their width (or within `band` of the grasp point
-    across them), and within `reach` of the grasp point along the closing axis (only the points
-    the camera saw, not completed ones, with `visible_only`)."""
-    p_W = np.asarray(target.p_W, float)
-    visible = np.asarray(target.visible, bool)
-    if visible_only and len(visible) == len(p_W):
-        p_W = p_W[visible]
-    p_G = (p_W - X_WG[:3, 3]) @ X_WG[:3, :3]
-    lo, hi = PAD_CORNERS_G[:, 1].min(), PAD_CORNERS_G[:, 1].max()
-    inside = ((p_G[:, 1] >= lo) & (p_G[:, 1] <= hi)
-              & (np.abs(p_G[:, 2]) <= (PAD_CORNERS_G[:, 2].max() if band is None else band))
-              & (np.abs(p_G[:, 0]) <= reach))
-    return p_G[inside]
-
-
-def _width_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
-    """Twice the largest |x_G| of the target's perceived points in the slab the open pads sweep,
-    out to their outer faces (a point under a pad counts): the opening the grasp needs. inf when
-    no point lies there (nothing to grasp)."""
-    p = _slab_points(target, X_WG, reach=PAD_CORNERS_G[:, 0].max())
-    return float(2.0 * np.abs(p[:, 0]).max()) if len(p) else float("inf")
-
-
-def _extent_along_closing(target: ObjectDescription, X_WG: np.ndarray, band: float
-                          ) -> tuple[float, float]:
-    """(lowest, highest) x_G [m] of the target's perceived points (completed ones too: the camera
-    misses a far end) within the pads' length along the approach and within `band` of the grasp
-    point across the pads; (0, 0) when there are none."""
-    x = _slab_points(target, X_WG, reach=np.inf, band=band)[:, 0]
-    return (float(x.min()), float(x.max())) if len(x) else (0.0, 0.0)
-
-
-def _depth_between_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float,
-                        seen: np.ndarray | None = None) -> float:
-    """How far along the approach the object reaches between the open pads [m]: from the pads'
-    tips back to its nearest point there (inf when perception gave no points: nothing to check).
-
-    Measured on the points the camera saw where there are any: symmetry completion mirrors a
-    flat blade about the handle's axis, which makes it look thicker than it is.
-    `seen`: those points (`_seen_between_pads`) when the caller has them already, as the
-    overlap and lower-half checks also take them."""
-    if len(target.p_W) == 0:
-        return float("inf")
-    p = _seen_between_pads(target, X_WG, open_width) if seen is None else seen
-    return float(PAD_CORNERS_G[:, 1].max() - p[:, 1].min()) if len(p) else 0.0
-
-
-def _any_visible(target: ObjectDescription) -> bool:
-    visible = np.asarray(target.visible, bool)
-    return len(visible) == len(target.p_W) and bool(visible.any())
-
-
-def _seen_between_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float
-                       ) -> np.ndarray:
-    """The target's points between the open pads (`_slab_points`), only those the camera saw when
-    it saw any: what the checks of `_refusal` measure (completion mirrors a flat blade upwards)."""
-    return _slab_points(target, X_WG, reach=open_width / 2, visible_only=_any_visible(target))
-
-
-def _overlap_across_pads(target: ObjectDescription, X_WG: np.ndarray, open_width: float,
-                         seen: np.ndarray | None = None) -> float:
-    """How far across the pads' width (z_G) the object spans between the open pads [m] (inf when
-    perception gave no points). Measured on the points the camera saw where there are any, as
-    `_depth_between_pads`."""
-    if len(target.p_W) == 0:
-        return float("inf")
-    p = _seen_between_pads(target, X_WG, open_width) if seen is None else seen
-    return float(np.ptp(p[:, 2])) if len(p) else 0.0
-
-
-PAD_BANDS = 4  # bands across the pads' 20 mm width for `_contact_share`
-CONTACT_TOLERANCE = 0.004  # [m] a band this close to the widest one touches too (a voxel)
-
-
-def _contact_share(target: ObjectDescription, X_WG: np.ndarray, open_width: float) -> float:
-    """Share of the bands across the pads' width that the object fills between the open pads
-    (and does not run past them) in which it is about as wide along the closing axis as its
-    widest band (within CONTACT_TOLERANCE): where the closing pads touch it first (1 when
-    perception gave no points or no band is left). Measured on all points, completed ones too:
-    the seen ones alone miss the occluded side of an object lying down."""
-    if len(target.p_W) == 0:
-        return 1.0
-    p = _slab_points(target, X_WG, reach=open_width / 2)
-    half = PAD_CORNERS_G[:, 2].max()
-    band = np.clip(((p[:, 2] + half) / (2 * half) * PAD_BANDS).astype(int), 0, PAD_BANDS - 1)
-    # A band where the object reaches out to a pad's inner face runs past that pad (a cup's
-    # handle): the pad goes beside it there, and it says nothing about where the pads touch.
-    past = open_width / 2 - CONTACT_TOLERANCE
-    widths = np.array([np.ptp(p[band == k, 0]) for k in range(PAD_BANDS)
-                       if np.count_nonzero(band == k) >= 2
-                       and np.abs(p[band == k, 0]).max() < past])
-    if len(widths) == 0:
-        return 1.0
-    return float(np.mean(widths >= widths.max() - CONTACT_TOLERANCE))
-
-
-def _pad_area_below_middle(target: ObjectDescription, X_WG: np.ndarray, open_width: float,
-                           table_z: float, cell: float = 0.001, seen: np.ndarray | None = None
-                           ) -> float:
-    """Area [m²] of a pad's face that lies over the lower half of the object lying between the
-    pads: seen along the closing axis, the face's part that is above the table and below half the
-    height of the object's top there (its widest section, for a rounded handle), and within
-    `cell` × 2.5 of a perceived point across the face. Measured on the points the camera saw where
-    there are any (as `_depth_between_pads`); inf when perception gave no points or the pads'
-    faces do not stand upright enough for a height to mean anything (a closing axis within 30° of
-    vertical)."""
-    if len(target.p_W) == 0:
-        return float("inf")
-    up = X_WG[2, 1:3]  # the world's vertical in the faces' (y_G, z_G) coordinates
-    if np.linalg.norm(up) < np.cos(np.deg2rad(30.0)):
-        return float("inf")
-    p = _seen_between_pads(target, X_WG, open_width) if seen is None else seen
-    if not len(p):
-        return 0.0
-    across = np.array([-up[1], up[0]]) / np.linalg.norm(up)  # horizontal, in the faces' plane
-    y = np.arange(PAD_CORNERS_G[:, 1].min() + cell / 2, PAD_CORNERS_G[:, 1].max(), cell)
-    z = np.arange(PAD_CORNERS_G[:, 2].min() + cell / 2, PAD_CORNERS_G[:, 2].max(), cell)
-    face = np.stack(np.meshgrid(y, z), axis=-1).reshape(-1, 2)  # cell centres (y_G, z_G)
-    height = X_WG[2, 3] + face @ up  # their world heights
-    top = X_WG[2, 3] + p[:, 1:3] @ up  # the points' world heights
-    near = np.abs((face @ across)[:, None] - (p[:, 1:3] @ across)[None, :]) <= 2.5 * cell
-    top_there = np.where(near, top[None, :], -np.inf).max(axis=1)
-    below = (height >= table_z) & (height <= table_z + 0.5 * (top_there - table_z))
-    return float(below.sum() * cell ** 2)
-
-
-# [m] the pads' thickness along x_G, outwards from their inner faces
-PAD_THICKNESS = WSG_PAD_SIZE[0]
-PAD_CELL = 0.004  # [m] cells of a pad's 12 × 20 mm cross-section (3 × 5), perception's voxel
-
-
-def _open_pad_cover(target: ObjectDescription, X_WG: np.ndarray, open_width: float) -> float:
-    """The larger, of the two open pads, share of a pad's cross-section across the approach
-    (PAD_CELL cells over its thickness and width) under which the camera saw the object within
-    the pad's length: where the pad would come down on the object instead of beside it."""
-    if len(target.p_W) == 0:
-        return 0.0
-    p = _slab_points(target, X_WG, reach=open_width / 2 + PAD_THICKNESS,
-                     visible_only=_any_visible(target))
-    half = PAD_CORNERS_G[:, 2].max()
-    nx, nz = int(round(PAD_THICKNESS / PAD_CELL)), int(round(2 * half / PAD_CELL))
-    cover = 0.0
-    for side in (-1.0, 1.0):
-        q = p[side * p[:, 0] > open_width / 2]
-        if len(q):
-            i = np.clip(((side * q[:, 0] - open_width / 2) / PAD_CELL).astype(int), 0, nx - 1)
-            k = np.clip(((q[:, 2] + half) / PAD_CELL).astype(int), 0, nz - 1)
-            cover = max(cover, np.unique(i * nz + k).size / (nx * nz))
-    return cover
-
-
-def _refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid, config,
-             table_z: float = 0.0) -> str:
-    """Why the geometry of the grasp X_WG on `part` rules it out before any IK ("" if it does
-    not): the part or the object does not fit the opening, the fingers would close along a long
-    part, too little of the object reaches between the pads, the pads would touch it first in
-    only part of the width it fills or press only on the upper half of a tool lying on the table
-    (its top at height `table_z`), an open pad would come down on a tool, or the object's weight
-    would turn it in the pads. `centroid`: the object's perceived centroid (None: no points)."""
-    width = _part_width(target, part, X_WG)
-    if width > config.open_width - config.width_margin:
-        # The box overstates what lies between the fingers for a grasp across a wall (a rim
-        # grasp on a bowl): measure the perceived points there instead.
-        width = min(width, _width_between_pads(target, X_WG))
-    if width > config.open_width - config.width_margin:
-        return f"{part} is {width:.3f} m across the fingers; the WSG opens {config.open_width} m"
-    # The part may fit while the object around it does not: an object longer than the opening
-    # along the closing axis, held by its ends, stays wedged between the opened fingers at the
-    # release. Only an object past both pads is
-    # refused: past one (a cup's handle, a bowl's far wall in a rim grasp) the fingers still open
-    # clear of it.
-    lo, hi = _extent_along_closing(target, X_WG, config.release_band)
-    half = (config.open_width - config.release_gap) / 2
-    if -lo > half and hi > half:
-        return (f"the object reaches past both pads ({hi - lo:.3f} m along the closing axis "
-                f"there; its {part} {width:.3f} m): the WSG, open to {config.open_width} m, "
-                "could not let go")
-    # Tools only: what lies under a pad of a tool lying on the table rests on the table and
-    # stops the pad; a container's wall or handle under a pad may yield (`max_pad_cover`).
-    cover = _open_pad_cover(target, X_WG, config.open_width) if target.is_tool else 0.0
-    if cover > config.max_pad_cover:
-        return (f"an open pad would come down on the object (it lies under {cover:.0%} of the "
-                f"pad's cross-section, at most {config.max_pad_cover:.0%})")
-    along = _closes_along_length(target, part, X_WG, config)
-    if along:
-        return along
-    seen = _seen_between_pads(target, X_WG, config.open_width)  # one selection for the checks
-    depth = _depth_between_pads(target, X_WG, config.open_width, seen)
-    if depth < config.min_pad_depth:
-        return (f"only {depth * 1000:.0f} mm of the object reaches between the pads (at least "
-                f"{config.min_pad_depth * 1000:.0f} mm): too flat to pick up from the table")
-    overlap = _overlap_across_pads(target, X_WG, config.open_width, seen)
-    if overlap < config.min_pad_overlap:
-        return (f"the object spans only {overlap * 1000:.0f} mm across the pads' width between "
-                f"them (at least {config.min_pad_overlap * 1000:.0f} mm): a thin edge pinched "
-                "between the pads slides out")
-    share = _contact_share(target, X_WG, config.open_width)
-    if share < config.min_contact_share:
-        return (f"the pads would touch the object's widest section over only {share:.0%} of "
-                f"the width the object fills between them (at least "
-                f"{config.min_contact_share:.0%}): a step or taper under the pads squeezes out")
-    if target.is_tool:
-        area = _pad_area_below_middle(target, X_WG, config.open_width, table_z, seen=seen)
-        if area < config.min_tool_grip_area:
-            return (f"the pads would press on only {area * 1e6:.0f} mm² of the tool's lower half "
-                    f"(at least {config.min_tool_grip_area * 1e6:.0f} mm²): pressed above its "
-                    "widest section, it is squeezed out from between them")
-        grip = float(np.ptp(seen[:, 0])) if len(seen) else float("inf")
-        if grip < config.min_tool_grip_width:
-            return (f"the tool is only {grip * 1000:.0f} mm thick between the pads (at least "
-                    f"{config.min_tool_grip_width * 1000:.0f} mm): a thin shaft rolls out of "
-                    "the squeezing pads")
-    if centroid is not None:
-        lever = torsion_lever(X_WG, centroid)
-        if lever > config.max_torsion_lever:
-            return (f"the object's weight would turn it about the closing axis with a "
-                    f"{lever:.3f} m lever (at most {config.max_torsion_lever} m): the pads resist "
-                    "that turn by friction alone")
-    return ""
-
-
-def torsion_lever(X_WG: np.ndarray, p_WC: np.ndarray) -> float:
-    """|x_G · ((p_C − p_grasp) × z_W)| [m]: the lever of a weight at p_WC about the gripper's
-    closing axis x_G through the grasp point. The pads resist a turn about x_G by friction over
-    their small contact patch only; a turn about the other axes presses on their whole face."""
-    p_grasp = X_WG[:3, 3] + GRASP_DEPTH * X_WG[:3, 1]
-    return float(abs(X_WG[:3, 0] @ np.cross(np.asarray(p_WC, float) - p_grasp, [0.0, 0.0, 1.0])))
-
-
-def _closes_along_length(target: ObjectDescription, part: str, X_WG: np.ndarray,
-                         config: PlannerConfig) -> str:
-    """Why the fingers would close along the length of an elongated part ("" if they do not)."""
-    box = target.part_boxes.get(part)
-    if box is None:
-        return ""
-    size = 2.0 * np.asarray(box.half_extents, float)
-    k = int(np.argmax(size))
-    others = np.delete(size, k)
-    axis = np.asarray(box.X_WB, float)[:3, k]
-    if size[k] >= config.max_length_ratio * others.max() and abs(axis @ X_WG[:3, 0]) > 0.7:
-        return (f"the fingers would close along the {size[k]:.3f} m length of {part}, not "
-                "across it")
-    return ""
-
-
 
 
 @dataclass

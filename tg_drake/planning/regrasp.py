@@ -15,9 +15,10 @@ For each, in order, the perceived object is moved there rigidly (points, frame, 
 given the pre-grasp hypotheses perception would make for it, with the feasibility stage's
 approach variants (and, when its pose label stays, the current candidates moved with it); the
 second leg is *reachable* when one of them, on a part the current candidates grasp, has
-inverse-kinematics solutions for every key pose of the task's turned place (the planner's own
-refusals, turns and waypoint IK; its motions are planned when the leg is). For the first such
-intermediate poses (at most `regrasp_max_legs`, of `regrasp_max_poses` examined), the first
+inverse-kinematics solutions for every key pose of the task's turned place (the feasibility
+stage's geometric refusals, the planner's turns and waypoint IK; its motions are planned when
+the leg is). For the first such intermediate poses (at most `regrasp_max_legs`, of
+`regrasp_max_poses` examined), the first
 leg is planned in full: picked with the current candidates (each followed by its
 finger-swapped twin, the same grasp: the wrist's last joint cannot turn a half turn about the
 vertical otherwise), placed in exactly that orientation, then the arm moved back to its start
@@ -36,6 +37,7 @@ from pydrake.math import RigidTransform
 from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.grasping.expansion import ExpansionConfig, executed_poses
+from tg_drake.grasping.feasibility import FeasibilityConfig, geometric_refusal
 from tg_drake.perception.config import PregraspConfig
 from tg_drake.perception.pregrasp import part_pregrasps
 from tg_drake.planning.ik import budget_spent, ik_solves, solve_budget
@@ -46,7 +48,6 @@ from tg_drake.planning.planner import (
     PlanResult,
     _Arms,
     _key_poses,
-    _refusal,
     _seeds,
     _task_place_variants,
     _waypoint_configurations,
@@ -148,12 +149,15 @@ def _second_leg_grasps(moved: ObjectDescription, table_z: float, carried=None, *
 
 def second_leg_reachable(moved: ObjectDescription, parts, *, placing: TaskPlacing, obstacles,
                          surfaces, config: PlannerConfig, scenario, table_z: float, q_start,
-                         carried=None, max_grasps: int = SECOND_LEG_GRASPS) -> str:
+                         carried=None, max_grasps: int = SECOND_LEG_GRASPS,
+                         feasibility: FeasibilityConfig | None = None) -> str:
     """Why no grasp of the object in its intermediate pose (`moved_object`; `_second_leg_grasps`
     with `carried`), on one of `parts` (in order), reaches every key pose of the task's place
     ("" when one does):
-    the planner's refusals, the task's turns and place yaws, inverse kinematics of each key
+    the feasibility stage's geometric refusals (`feasibility`: its config, default
+    FeasibilityConfig()), the task's turns and place yaws, inverse kinematics of each key
     pose (the motions between them are planned when the second leg is)."""
+    feasibility = feasibility or FeasibilityConfig()
     X_WG_all, labels = _second_leg_grasps(moved, table_z, carried,
                                           approach=config.pregrasp_distance)
     order = [i for part in parts for i in np.flatnonzero(labels == PART_LABELS.index(part))]
@@ -176,7 +180,7 @@ def second_leg_reachable(moved: ObjectDescription, parts, *, placing: TaskPlacin
             return why or "not examined"
         part = PART_LABELS[int(labels[i])]
         X_WG = X_WG_all[i]
-        refusal = _refusal(moved, part, X_WG, centroid, config, table_z)
+        refusal = geometric_refusal(moved, part, X_WG, centroid, feasibility, table_z)
         if refusal:
             why = why or refusal
             continue
@@ -226,7 +230,8 @@ def intermediates(target: ObjectDescription, placing: TaskPlacing, obstacles=()
 def plan_regrasp_leg(candidates: GraspCandidates, *, target: ObjectDescription, obstacles=(),
                      q_start, table_z: float, placing: TaskPlacing, direct: PlanResult,
                      config: PlannerConfig | None = None, scenario=None, exclude_parts=(),
-                     max_parts: int | None = None, surfaces=()) -> PlanResult:
+                     max_parts: int | None = None, surfaces=(),
+                     feasibility: FeasibilityConfig | None = None) -> PlanResult:
     """A place-and-regrasp's first leg (module doc) for the p&pIn* `placing` whose direct plan
     `direct` failed: a plan that puts the object down in an intermediate resting pose and moves
     the arm back to `q_start` (`Plan.regrasp`), or `direct` with the reason none was found."""
@@ -257,7 +262,7 @@ def plan_regrasp_leg(candidates: GraspCandidates, *, target: ObjectDescription, 
         why = second_leg_reachable(moved_object(target, inter.X_WO), parts, placing=placing,
                                    obstacles=obstacles, surfaces=surfaces, config=config,
                                    scenario=scenario, table_z=table_z, q_start=q_start,
-                                   carried=carried)
+                                   carried=carried, feasibility=feasibility)
         if why:
             tried.append(f"{label}: the next grasp cannot ({why})")
             continue
@@ -350,8 +355,9 @@ def plan_task_leg(scene, candidates: GraspCandidates, *, place_xy, q_start, regr
                   return_home: bool = False, **kwargs) -> PlanResult:
     """`tg_drake.planning.planner.plan_for_scene`, and where a p&pIn* task's turn in the hand
     cannot be placed: with `regrasp`, a place-and-regrasp's first leg (`plan_regrasp_leg`);
-    without, the reason says that none was allowed. With `return_home` every plan ends with the
-    arm back at `q_start` (a regrasp leg does anyway). The whole request keeps within the
+    without, the reason says that none was allowed (`feasibility`: the feasibility stage's config,
+    whose geometric refusals judge the second leg's grasps). With `return_home` every plan ends
+    with the arm back at `q_start` (a regrasp leg does anyway). The whole request keeps within the
     budget `PlannerConfig.max_ik_solves`; `PlanResult.ik_solves` says what it used."""
     config = kwargs.get("config") or PlannerConfig()
     n0 = ik_solves()
@@ -366,7 +372,8 @@ def plan_task_leg(scene, candidates: GraspCandidates, *, place_xy, q_start, regr
 
 
 def _plan_task_leg(scene, candidates: GraspCandidates, *, place_xy, q_start, regrasp: bool,
-                   return_home: bool, **kwargs) -> PlanResult:
+                   return_home: bool, feasibility: FeasibilityConfig | None = None,
+                   **kwargs) -> PlanResult:
     result = plan_for_scene(scene, candidates, place_xy=place_xy, q_start=q_start, **kwargs)
     if result.status == "planned" and return_home:
         target = scene.objects[candidates.target]
@@ -391,4 +398,4 @@ def _plan_task_leg(scene, candidates: GraspCandidates, *, place_xy, q_start, reg
     kwargs = {k: v for k, v in kwargs.items() if k not in ("placing", "handover", "category")}
     return plan_regrasp_leg(candidates, target=target, obstacles=others, q_start=q_start,
                             table_z=float(scene.X_WT[2, 3]), placing=placing, direct=result,
-                            **kwargs)
+                            feasibility=feasibility, **kwargs)

@@ -20,7 +20,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from tg_drake.bench import Figure
 from tg_drake.errors import PlanningError, SimulationError
-from tg_drake.grasping.feasibility import GRASP_DEPTH  # [m] the grasp point along +y_G
+from tg_drake.grasping.pads import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.objects import get_object
 from tg_drake.outcome import CLOSED_ON_AIR
 from tg_drake.planning.ik import make_arm_plant, solve_ik

@@ -17,6 +17,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
+from tg_drake.grasping.feasibility import FeasibilityConfig
 from tg_drake.planning.planner import PlannerConfig, PlanResult
 from tg_drake.planning.regrasp import plan_task_leg
 from tg_drake.planning.task_motion import TaskPlacing
@@ -88,7 +89,8 @@ class GraspPlanner(LeafSystem):
 
     def __init__(self, *, place_xy, start_time: float = 0.0, period: float = 0.05,
                  config: PlannerConfig | None = None, scenario: Scenario | None = None,
-                 placing: TaskPlacing | None = None, surfaces=(), handover=None):
+                 placing: TaskPlacing | None = None, surfaces=(), handover=None,
+                 feasibility: FeasibilityConfig | None = None):
         """
         Args:
             place_xy: (2,) world xy where the target object's frame origin is placed [m].
@@ -104,6 +106,8 @@ class GraspPlanner(LeafSystem):
             handover: a pass's receiver (`tg_drake.planning.handover.Handover`): the plan hands
                 the object over to it; its part comes from the category distribution of the
                 optional ``grasp_semantics`` input.
+            feasibility: the feasibility stage's config, whose geometric refusals judge the
+                grasps of a place-and-regrasp's second leg (default: FeasibilityConfig()).
         """
         super().__init__()
         if len(place_xy) != 2:
@@ -115,6 +119,7 @@ class GraspPlanner(LeafSystem):
         self._scenario = scenario
         self._placing, self._surfaces = placing, tuple(surfaces)
         self._handover = handover
+        self._feasibility = feasibility or FeasibilityConfig()
 
         self._scene_port = self.DeclareAbstractInputPort(
             "scene_description", AbstractValue.Make(SceneDescription(objects=[], X_WT=np.eye(4))))
@@ -208,7 +213,8 @@ class GraspPlanner(LeafSystem):
                                    handover=self._handover,
                                    category=semantics.category if semantics else None,
                                    regrasp=request.regrasp,
-                                   return_home=request.return_home)
+                                   return_home=request.return_home,
+                                   feasibility=self._feasibility)
             memory = dataclasses.replace(memory, ik_solves=memory.ik_solves + result.ik_solves)
             if result.status == "planned":
                 memory = dataclasses.replace(memory, result=result, t_plan=context.get_time())
