@@ -186,9 +186,13 @@ def gripper_boxes(opening: float, approach: float = 0.0) -> list[tuple[str, np.n
     return out
 
 
+# The 8 corners of a unit box's half sizes, as signs (x, y, z) (built once: `_box_corners_W` is
+# called for every box of every pose).
+_CORNER_SIGNS = np.array(np.meshgrid(*[(-1.0, 1.0)] * 3)).reshape(3, -1).T
+
+
 def _box_corners_W(X_WG: np.ndarray, centre, half) -> np.ndarray:
-    s = np.array(np.meshgrid(*[(-1.0, 1.0)] * 3)).reshape(3, -1).T
-    return (centre + s * half) @ X_WG[:3, :3].T + X_WG[:3, 3]
+    return (centre + _CORNER_SIGNS * half) @ X_WG[:3, :3].T + X_WG[:3, 3]
 
 
 def penetration(X_WG: np.ndarray, p_W: np.ndarray, boxes, k: int) -> dict[str, float]:
