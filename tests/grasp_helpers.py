@@ -37,21 +37,8 @@ def grasp_pose(p_W_grasp, approach_W, closing_W) -> np.ndarray:
 
 
 def scene_with_box(p_W_center, extents=(0.07, 0.07, 0.20)) -> SceneDescription:
-    """One upright box on the table, bottom / middle / top thirds as its parts."""
-    extents = np.asarray(extents, float)
-    X_WO = np.eye(4)
-    X_WO[:3, 3] = p_W_center
-    boxes = {}
-    for k, name in enumerate(("bottom", "middle", "top")):
-        X_WB = X_WO.copy()
-        X_WB[2, 3] += -extents[2] / 2 + extents[2] * (k + 0.5) / 3
-        boxes[name] = PartBox(X_WB, np.array([extents[0], extents[1], extents[2] / 3]) / 2)
-    box = ObjectDescription(
-        p_W=np.zeros((0, 3)), n_W=np.zeros((0, 3)), labels=np.zeros(0, int),
-        visible=np.zeros(0, bool), X_WO=X_WO, extents=extents, pose="upright",
-        pose_likelihood={"upright": 1.0}, part_probabilities=dict.fromkeys(boxes, 1.0),
-        part_boxes=boxes, pregrasp_X_WG=np.zeros((0, 4, 4)), pregrasp_parts=np.zeros(0, int))
-    return SceneDescription(objects=[box], X_WT=np.eye(4), target=0)
+    """One upright box on the table, bottom / middle / top thirds as its parts (`box_object`)."""
+    return SceneDescription(objects=[box_object(p_W_center, extents)], X_WT=np.eye(4), target=0)
 
 
 def ranked(poses_and_parts, scores=None) -> GraspCandidates:

@@ -55,6 +55,7 @@ from tg_drake.grasping.pads import (
     COLLISION,
     WOULD_NOT_HOLD,
     geometric_refusal,
+    in_slab,
 )
 from tg_drake.robot import (
     WSG_BODY_CENTRE_G,
@@ -63,7 +64,6 @@ from tg_drake.robot import (
     WSG_GRASP_POINT_G,
     WSG_MAX_OPENING,
     WSG_PAD_FRICTION,
-    WSG_PAD_SIZE,
     wsg_pad_boxes,
 )
 from tg_drake.types import CATEGORIES, PART_LABELS, GraspCandidates, SceneDescription
@@ -390,10 +390,7 @@ def between_pads(X_WG: np.ndarray, p_W: np.ndarray, opening: float
     which of them lie between its pads opened `opening` [m] (within the pads' length along y_G
     and their width along z_G)."""
     p_G = (np.asarray(p_W, float).reshape(-1, 3) - X_WG[:3, 3]) @ X_WG[:3, :3]
-    y0, y1 = WSG_GRASP_POINT_G[1] - WSG_PAD_SIZE[1] / 2, WSG_GRASP_POINT_G[1] + WSG_PAD_SIZE[1] / 2
-    inside = ((p_G[:, 1] >= y0) & (p_G[:, 1] <= y1) & (np.abs(p_G[:, 2]) <= WSG_PAD_SIZE[2] / 2)
-              & (np.abs(p_G[:, 0]) <= opening / 2))
-    return inside, p_G
+    return in_slab(p_G, reach=opening / 2), p_G
 
 
 def grip_width(X_WG: np.ndarray, p_W: np.ndarray, opening: float) -> float:

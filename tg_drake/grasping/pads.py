@@ -50,11 +50,17 @@ def slab_points(target: ObjectDescription, X_WG: np.ndarray, *, reach: float,
     if visible_only and len(visible) == len(p_W):
         p_W = p_W[visible]
     p_G = (p_W - X_WG[:3, 3]) @ X_WG[:3, :3]
+    return p_G[in_slab(p_G, reach=reach, band=band)]
+
+
+def in_slab(p_G: np.ndarray, *, reach: float, band: float | None = None) -> np.ndarray:
+    """(N,) bool: which points p_G (N, 3), in the gripper frame G, lie in the slab the open
+    pads sweep: along the approach over the pads' length, within `band` of the grasp point
+    across the pads (default: their width) and within `reach` of it along the closing axis."""
     lo, hi = PAD_CORNERS_G[:, 1].min(), PAD_CORNERS_G[:, 1].max()
-    inside = ((p_G[:, 1] >= lo) & (p_G[:, 1] <= hi)
-              & (np.abs(p_G[:, 2]) <= (PAD_CORNERS_G[:, 2].max() if band is None else band))
-              & (np.abs(p_G[:, 0]) <= reach))
-    return p_G[inside]
+    return ((p_G[:, 1] >= lo) & (p_G[:, 1] <= hi)
+            & (np.abs(p_G[:, 2]) <= (PAD_CORNERS_G[:, 2].max() if band is None else band))
+            & (np.abs(p_G[:, 0]) <= reach))
 
 
 def width_between_pads(target: ObjectDescription, X_WG: np.ndarray) -> float:
