@@ -192,25 +192,72 @@ _CORNER_SIGNS = np.array(np.meshgrid(*[(-1.0, 1.0)] * 3)).reshape(3, -1).T
 
 
 def _box_corners_W(X_WG: np.ndarray, centre, half) -> np.ndarray:
-    return (centre + _CORNER_SIGNS * half) @ X_WG[:3, :3].T + X_WG[:3, 3]
+    """(…, 8, 3) the world corners of boxes (centre, half sizes: (…, 3)) in G, the gripper at
+    X_WG (…, 4, 4) (the leading shapes broadcast)."""
+    return ((np.expand_dims(centre, -2) + _CORNER_SIGNS * np.expand_dims(half, -2))
+            @ np.swapaxes(X_WG[..., :3, :3], -1, -2) + X_WG[..., None, :3, 3])
+
+
+def _in_G(X_WG: np.ndarray, p_W: np.ndarray) -> np.ndarray:
+    """(M, n, 3) the points p_W (n, 3) in the gripper frame of each pose X_WG (M, 4, 4) (one
+    product per pose, as for a single pose)."""
+    return (p_W - X_WG[:, None, :3, 3]) @ X_WG[:, :3, :3]
+
+
+def _cuts(p_G: np.ndarray, centre: np.ndarray, half: np.ndarray, k: int,
+          present: np.ndarray | None = None) -> np.ndarray:
+    """(M, B) how deep [m] the points p_G (M, n, 3), each in its pose's gripper frame, cut each
+    of B boxes (centre, half sizes: (B, 3), or (M, B, 3) per pose): the k-th deepest point's
+    depth (robust to k − 1 stray points), 0 when fewer than k points are inside some box (only
+    those count). `present` (M, B) bool: the boxes each pose has (default: all; 0 for the
+    others)."""
+    m, n = p_G.shape[:2]
+    b = np.shape(centre)[-2]
+    per_pose = np.ndim(centre) == 3
+    present = np.ones((m, b), bool) if present is None else present
+    out = np.zeros((m, b))
+    if n < k:
+        return out
+    lo = np.where(present[..., None], centre - half, np.inf).min(axis=1)
+    hi = np.where(present[..., None], centre + half, -np.inf).max(axis=1)
+    inside = np.ones((m, n), bool)
+    for a in range(3):
+        inside &= (p_G[..., a] >= lo[:, a, None]) & (p_G[..., a] <= hi[:, a, None])
+    pose, i = np.nonzero(inside)
+    q = p_G[pose, i]  # by pose
+    for j in range(b):
+        c, h = (centre[pose, j], half[pose, j]) if per_pose else (centre[j], half[j])
+        # Only a point in the box (depth ≥ 0) makes a cut; one more than 1e-100 m out of it
+        # on some axis is out of it (its distance > 0 in `box_signed_distance`).
+        near = np.ones(len(q), bool)
+        for a in range(3):
+            near &= np.abs(q[:, a] - c[..., a]) - h[..., a] <= 1e-100
+        depth = -box_signed_distance(q[near] - c[near] if per_pose else q[near] - c,
+                                     h[near] if per_pose else h)
+        deep = depth >= 0.0
+        depth, of = depth[deep], pose[near][deep]
+        count = np.bincount(of, minlength=m)
+        enough = count >= k
+        if enough.any():  # the k-th deepest of each pose's points in the box
+            out[enough, j] = depth[np.lexsort((depth, of))][np.cumsum(count)[enough] - k]
+    return np.where(present, out, 0.0)
+
+
+def _named(names, depths: np.ndarray) -> dict[str, float]:
+    """Box name → the deepest cut (`_cuts`, one pose's row) of the boxes of that name."""
+    out = dict.fromkeys(names, 0.0)
+    for name, d in zip(names, depths.tolist(), strict=True):
+        out[name] = max(out[name], d)
+    return out
 
 
 def penetration(X_WG: np.ndarray, p_W: np.ndarray, boxes, k: int) -> dict[str, float]:
     """Box name → how deep [m] the points p_W cut it: the k-th deepest point's depth (robust to
     k − 1 stray points), 0 when fewer than k points are inside."""
-    out = {name: 0.0 for name, _, _ in boxes}
-    if len(p_W) < k:
-        return out
-    p_G = (np.asarray(p_W, float) - X_WG[:3, 3]) @ X_WG[:3, :3]
-    lo = np.min([c - h for _, c, h in boxes], axis=0)
-    hi = np.max([c + h for _, c, h in boxes], axis=0)
-    p_G = p_G[np.all((p_G >= lo) & (p_G <= hi), axis=1)]  # only points inside some box count
-    if len(p_G) < k:
-        return out
-    for name, c, h in boxes:
-        depth = -box_signed_distance(p_G - c, h)
-        out[name] = max(out[name], float(max(np.partition(depth, -k)[-k], 0.0)))
-    return out
+    p_G = _in_G(np.asarray(X_WG, float)[None], np.asarray(p_W, float).reshape(-1, 3))
+    return _named([name for name, _, _ in boxes],
+                  _cuts(p_G, np.array([c for _, c, _ in boxes]),
+                        np.array([h for _, _, h in boxes]), k)[0])
 
 
 @dataclass(frozen=True)
@@ -243,17 +290,45 @@ def collision(X_WG: np.ndarray, *, others_p_W: np.ndarray, table_z: float, appro
     """The open gripper swept from `approach` [m] back along its approach to X_WG, and the pads
     closing from open to `closed_width` [m] (the target's width between them; None: not
     checked), against the other objects' points and the table plane at height `table_z`."""
+    return _collisions(np.asarray(X_WG, float)[None], others_p_W=others_p_W, table_z=table_z,
+                       approach=approach, config=config, closed_widths=[closed_width])[0]
+
+
+def _collisions(X_WG: np.ndarray, *, others_p_W: np.ndarray, table_z: float, approach: float,
+                config: FeasibilityConfig, closed_widths) -> list[Collision]:
+    """`collision` of each pose X_WG (M, 4, 4), its pads closing to closed_widths[i] [m] (None:
+    not checked)."""
     boxes = gripper_boxes(config.opening, approach)
-    if closed_width is not None:
-        boxes = boxes + closing_sweep(config.opening, closed_width)
-    cut = penetration(X_WG, others_p_W, boxes, config.min_points)
-    name = max(cut, key=cut.get)
-    table = min(_box_corners_W(X_WG, c, h)[:, 2].min() for _, c, h in boxes) - table_z
-    if cut[name] > config.point_tolerance:
-        return Collision(cut[name], name, "other object", float(table))
-    if table < config.table_clearance:
-        return Collision(float(config.table_clearance - table), "", "table", float(table))
-    return Collision(0.0, "", "", float(table))
+    sweeps = [[] if w is None else closing_sweep(config.opening, w) for w in closed_widths]
+    extra = max(map(len, sweeps), default=0)
+    names = [n for n, _, _ in boxes] + [""] * extra
+    centre = np.zeros((len(X_WG), len(names), 3))
+    half = np.zeros_like(centre)
+    present = np.zeros(centre.shape[:2], bool)
+    centre[:, :len(boxes)] = [c for _, c, _ in boxes]
+    half[:, :len(boxes)] = [h for _, _, h in boxes]
+    present[:, :len(boxes)] = True
+    for i, sweep in enumerate(sweeps):
+        for j, (name, c, h) in enumerate(sweep, start=len(boxes)):
+            names[j], centre[i, j], half[i, j], present[i, j] = name, c, h, True
+    p_G = _in_G(X_WG, np.asarray(others_p_W, float).reshape(-1, 3))
+    cuts = _cuts(p_G, centre, half, config.min_points, present)
+    lowest = np.where(present[..., None], _box_corners_W(X_WG[:, None], centre, half)[..., 2],
+                      np.inf).min(axis=(1, 2))
+    out = []
+    for i in range(len(X_WG)):
+        cut = _named([n for n, p in zip(names, present[i], strict=True) if p],
+                     cuts[i, present[i]])
+        name = max(cut, key=cut.get)
+        table = lowest[i] - table_z
+        if cut[name] > config.point_tolerance:
+            out.append(Collision(cut[name], name, "other object", float(table)))
+        elif table < config.table_clearance:
+            out.append(Collision(float(config.table_clearance - table), "", "table",
+                                 float(table)))
+        else:
+            out.append(Collision(0.0, "", "", float(table)))
+    return out
 
 
 # --- (b) hold margin ----------------------------------------------------------------------------
@@ -359,29 +434,64 @@ def squeeze_tangent(n_G: np.ndarray, side: float, weights: np.ndarray | None = N
     scaled to a unit x_G part (magnitude tan θ, θ the normal's lean from x_G). Zero without
     normals."""
     n = np.asarray(n_G, float).reshape(-1, 3)
-    if not len(n):
-        return np.zeros(2)
-    n = n * np.where(n[:, 0] * side < 0, -1.0, 1.0)[:, None]  # outward: towards the pad
     w = np.ones(len(n)) if weights is None else np.asarray(weights, float)
-    if w.sum() <= 0:
-        return np.zeros(2)
-    mean = w @ n / w.sum()
-    if abs(mean[0]) < 1e-9:
-        return np.zeros(2)
+    return _squeeze_tangents(n, side, w, np.zeros(len(n), int), 1)[0]
+
+
+def _squeeze_tangents(n_G: np.ndarray, side: float, weights: np.ndarray, group: np.ndarray,
+                      n: int) -> np.ndarray:
+    """(n, 2) `squeeze_tangent` of each of n patches: the normals n_G (s, 3) and the weights
+    (s,) of its points, `group` (s,) the patch of each point (0 … n − 1, ascending)."""
+    n_G = n_G * np.where(n_G[:, 0] * side < 0, -1.0, 1.0)[:, None]  # outward: towards the pad
+    count = np.bincount(group, minlength=n)
+    end = np.cumsum(count)
+    total, mean = np.zeros(n), np.zeros((n, 3))
+    for j, (a, b) in enumerate(zip(end - count, end, strict=True)):
+        if b > a:  # each patch's sums over its own points, as for one patch alone
+            total[j] = weights[a:b].sum()
+            mean[j] = weights[a:b] @ n_G[a:b]
+    ok = total > 0
+    mean[ok] /= total[ok, None]
+    ok &= np.abs(mean[:, 0]) >= 1e-9
+    out = np.zeros((n, 2))
     # The pad pushes the object along −n; per unit of its x_G part: −n / |n_x|.
-    return -mean[1:] / abs(mean[0])
+    out[ok] = -mean[ok, 1:] / np.abs(mean[ok, 0])[:, None]
+    return out
 
 
-def _patch(q: np.ndarray, cell: float) -> tuple[float, float, np.ndarray, float]:
-    """(area, smaller extent, centre (y, z), mean cell distance from the centre) of patch points
-    q (n, 2) in a pad's face coordinates."""
-    cells = np.unique(np.floor(q / cell).astype(int), axis=0)
+def _patches(q: np.ndarray, group: np.ndarray, n: int, cell: float
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per patch: (area, smaller extent, centre (y, z), mean cell distance from the centre),
+    arrays (n,), (n,), (n, 2), (n,), of the patch points q (s, 2) in a pad's face coordinates,
+    `group` (s,) the patch of each point (0 … n − 1, ascending, none empty)."""
+    ij = np.floor(q / cell).astype(int)
+    lo = ij.min(axis=0)
+    span = ij.max(axis=0) - lo + 1
+    key = (group * span[0] + ij[:, 0] - lo[0]) * span[1] + ij[:, 1] - lo[1]
+    _, first = np.unique(key, return_index=True)  # each occupied cell once, by patch, y, z
+    cells, of = ij[first], group[first]
+    n_cells = np.bincount(of, minlength=n)
+    end = np.cumsum(n_cells)
     centres = (cells + 0.5) * cell
-    centre = centres.mean(axis=0)
-    extent = float(np.min(np.ptp(q, axis=0))) if len(q) > 1 else 0.0
-    radius = float(np.linalg.norm(centres - centre, axis=1).mean())
+    # Each patch's mean cell centre, summed cell after cell (as `ndarray.mean(axis=0)` does).
+    padded = np.zeros((n, n_cells.max(), 2))
+    padded[of, np.arange(len(of)) - (end - n_cells)[of]] = centres
+    centre = padded.cumsum(axis=1)[np.arange(n), n_cells - 1] / n_cells[:, None]
+    d = np.linalg.norm(centres - centre[of], axis=1)
+    radius = np.array([np.add.reduce(d[e - k:e]) for e, k in zip(end, n_cells, strict=True)]
+                      ) / n_cells
+    start = np.flatnonzero(np.r_[True, group[1:] != group[:-1]])
+    extent = np.where(np.diff(np.r_[start, len(group)]) > 1,
+                      (np.maximum.reduceat(q, start) - np.minimum.reduceat(q, start)).min(axis=1),
+                      0.0)
     # A single cell still turns about its own extent: at least a cell's mean radius (≈ 0.38 a).
-    return len(cells) * cell ** 2, extent, centre, max(radius, 0.38 * cell)
+    return n_cells * cell ** 2, extent, centre, np.maximum(radius, 0.38 * cell)
+
+
+def _between(p_G: np.ndarray, opening: float) -> np.ndarray:
+    """(…,) bool: which points p_G (…, 3), in the gripper frame, lie between its pads opened
+    `opening` [m] (within the pads' length along y_G and their width along z_G)."""
+    return in_slab(p_G.reshape(-1, 3), reach=opening / 2).reshape(p_G.shape[:-1])
 
 
 def between_pads(X_WG: np.ndarray, p_W: np.ndarray, opening: float
@@ -389,8 +499,8 @@ def between_pads(X_WG: np.ndarray, p_W: np.ndarray, opening: float
     """(inside (n,) bool, p_G (n, 3)): the points p_W (n, 3) in the gripper frame at X_WG, and
     which of them lie between its pads opened `opening` [m] (within the pads' length along y_G
     and their width along z_G)."""
-    p_G = (np.asarray(p_W, float).reshape(-1, 3) - X_WG[:3, 3]) @ X_WG[:3, :3]
-    return in_slab(p_G, reach=opening / 2), p_G
+    p_G = _in_G(np.asarray(X_WG, float)[None], np.asarray(p_W, float).reshape(-1, 3))[0]
+    return _between(p_G, opening), p_G
 
 
 def grip_width(X_WG: np.ndarray, p_W: np.ndarray, opening: float) -> float:
@@ -408,39 +518,70 @@ def hold(X_WG: np.ndarray, *, target_p_W: np.ndarray, mass: float,
     the open gripper swept `approach` [m] along its approach (the gripper pushes the object
     there: whether it still holds is the fitted model's to say). `normals_W`: the points' surface
     normals (`point_normals`, any sign) for the squeeze; None: no squeeze."""
+    return _holds(np.asarray(X_WG, float)[None], target_p_W=target_p_W, mass=mass,
+                  config=config, p_WCoM=p_WCoM, approach=approach, normals_W=normals_W)[0]
+
+
+def _holds(X_WG: np.ndarray, *, target_p_W: np.ndarray, mass: float,
+           config: FeasibilityConfig, p_WCoM: np.ndarray | None = None,
+           approach: float = 0.0, normals_W: np.ndarray | None = None) -> list[Hold]:
+    """`hold` of each grasp pose X_WG (M, 4, 4)."""
     p_W = np.asarray(target_p_W, float)
     com = p_W.mean(axis=0) if p_WCoM is None and len(p_W) else np.asarray(p_WCoM, float)
-    R, t = X_WG[:3, :3], X_WG[:3, 3]
-    inside, p_G = between_pads(X_WG, p_W, config.opening)
-    between = p_G[inside]
+    p_G = _in_G(X_WG, p_W.reshape(-1, 3))
+    inside = _between(p_G, config.opening)
     N = min(config.grip_force, WSG_FORCE_LIMIT)
     mu = config.friction
-    cut = penetration(X_WG, p_W, gripper_boxes(config.opening, approach), config.min_points)
-    cuts = dict(pad_cut=max(cut["left pad"], cut["right pad"]), housing_cut=cut["housing"])
-    if len(between) < 2:
-        p = t + R @ WSG_GRASP_POINT_G
-        return Hold(0.0, len(between), 0.0, 0.0, 0.0, p, mass, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
-                    **cuts)
+    boxes = gripper_boxes(config.opening, approach)
+    cut = _cuts(p_G, np.array([c for _, c, _ in boxes]), np.array([h for _, _, h in boxes]),
+                config.min_points)
+    names = [name for name, _, _ in boxes]
+    cuts = []
+    for row in cut:
+        c = _named(names, row)
+        cuts.append(dict(pad_cut=max(c["left pad"], c["right pad"]), housing_cut=c["housing"]))
+    count = inside.sum(axis=1)
+    out = [None] * len(X_WG)
+    for i in np.flatnonzero(count < 2):
+        p = X_WG[i, :3, 3] + X_WG[i, :3, :3] @ WSG_GRASP_POINT_G
+        out[i] = Hold(0.0, int(count[i]), 0.0, 0.0, 0.0, p, mass, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                      **cuts[i])
+    some = np.flatnonzero(count >= 2)  # the poses with points between the pads, k = 0 … K − 1
+    if not len(some):
+        return out
+    # Their points between the pads, pose after pose (k: each point's pose).
+    pose, point = np.nonzero(inside[some])
+    between = p_G[some[pose], point]
+    start = np.cumsum(count[some]) - count[some]
     x = between[:, 0]
-    lo, hi = x.min(), x.max()
-    on_left, on_right = x <= lo + config.contact_depth, x >= hi - config.contact_depth
-    left, right = between[on_left][:, 1:], between[on_right][:, 1:]
-    (aL, eL, cL, rL), (aR, eR, cR, rR) = (_patch(q, config.patch_cell) for q in (left, right))
-    c_G = np.array([(lo + hi) / 2, *(cL + cR) / 2])
-    p_WC = t + R @ c_G
+    lo, hi = np.minimum.reduceat(x, start), np.maximum.reduceat(x, start)
+    on_left = x <= lo[pose] + config.contact_depth
+    on_right = x >= hi[pose] - config.contact_depth
+    (aL, eL, cL, rL), (aR, eR, cR, rR) = (
+        _patches(between[on][:, 1:], pose[on], len(some), config.patch_cell)
+        for on in (on_left, on_right))
+    X = X_WG[some]
+    R, t = X[:, :3, :3], X[:, :3, 3]
+    c_G = np.column_stack([(lo + hi) / 2, (cL + cR) / 2])
+    p_WC = t + (R @ c_G[:, :, None])[..., 0]
     force_cap = 2 * mu * N
     torque_cap = mu * N * (rL + rR)
     # The squeeze: the pads' own push along their faces (towards the palm it only seats the
     # object against it, so only its part out of the hand, +y_G, and across the pads, ±z_G).
-    push = np.zeros(2)
+    squeeze_force = np.zeros(len(some))  # [N] friction must carry it before any load
     if normals_W is not None:
+        normals_W = np.asarray(normals_W, float)
+        n_G = np.concatenate([normals_W[point[a:b]] @ R[k] for k, (a, b) in enumerate(
+            zip(start, start + count[some], strict=True))])  # one product per pose
         # Each point weighs as a compliant pad presses it: by how deep the pad reaches past it.
-        n_G = np.asarray(normals_W, float)[inside] @ R
         depth = config.contact_depth
-        push = (squeeze_tangent(n_G[on_left], -1.0, 1.0 - (x[on_left] - lo) / depth)
-                + squeeze_tangent(n_G[on_right], 1.0, 1.0 - (hi - x[on_right]) / depth))
-        push[0] = max(push[0], 0.0)
-    squeeze_force = N * float(np.linalg.norm(push))  # [N] friction must carry it before any load
+        push = (_squeeze_tangents(n_G[on_left], -1.0, 1.0 - (x[on_left] - lo[pose[on_left]])
+                                  / depth, pose[on_left], len(some))
+                + _squeeze_tangents(n_G[on_right], 1.0, 1.0 - (hi[pose[on_right]]
+                                                               - x[on_right]) / depth,
+                                    pose[on_right], len(some)))
+        push[:, 0] = np.maximum(push[:, 0], 0.0)
+        squeeze_force = N * np.array([float(np.linalg.norm(v)) for v in push])
     # The loads: the patches accelerate the object by a against gravity: f = m (a − g).
     dirs = np.linspace(0.0, 2 * np.pi, 8, endpoint=False)
     accel = np.vstack([[0.0, 0.0, 0.0], [0.0, 0.0, config.lift_acceleration],
@@ -448,21 +589,29 @@ def hold(X_WG: np.ndarray, *, target_p_W: np.ndarray, mass: float,
                            [np.cos(dirs), np.sin(dirs), np.zeros_like(dirs)])])
     f_W = mass * (accel + [0.0, 0.0, GRAVITY])
     r_W = com - p_WC
-    tau_W = np.cross(r_W, f_W)
-    x_G = R[:, 0]
-    f_t = np.linalg.norm(f_W - np.outer(f_W @ x_G, x_G), axis=1)  # across the pads' faces
-    tau_x = np.abs(tau_W @ x_G)
-    u = np.sqrt(((f_t + squeeze_force) / force_cap) ** 2
-                + (tau_x / max(torque_cap, 1e-12)) ** 2)
-    lever = float(abs(x_G @ np.cross(r_W, [0.0, 0.0, 1.0])))
-    return Hold(width=float(hi - lo), n_points=len(between), patch_area=float(min(aL, aR)),
-                patch_extent=float(min(eL, eR)), torsion_radius=float((rL + rR) / 2), p_WC=p_WC,
-                mass=float(mass), lever=lever, force_capacity=force_cap,
-                torque_capacity=torque_cap,
-                translational_margin=float(force_cap / f_t.max()) if f_t.max() > 0 else np.inf,
-                torsional_margin=float(torque_cap / tau_x.max()) if tau_x.max() > 0 else np.inf,
-                margin=float(1.0 / u.max()) if u.max() > 0 else np.inf,
-                squeeze=squeeze_force / force_cap, **cuts)
+    tau_W = np.cross(r_W[:, None], f_W)
+    x_G = X[:, :3, 0]
+    # Across the pads' faces (f_W less its part along x_G).
+    f_t = np.linalg.norm(f_W - (f_W @ x_G[..., None]) * x_G[:, None], axis=2)
+    tau_x = np.abs((tau_W @ x_G[..., None])[..., 0])
+    u = np.sqrt(((f_t + squeeze_force[:, None]) / force_cap) ** 2
+                + (tau_x / np.maximum(torque_cap, 1e-12)[:, None]) ** 2)
+    lever = np.abs((x_G[:, None] @ np.cross(r_W, [0.0, 0.0, 1.0])[..., None])[:, 0, 0])
+    f_max, tau_max, u_max = f_t.max(axis=1), tau_x.max(axis=1), u.max(axis=1)
+    for k, i in enumerate(some):
+        out[i] = Hold(width=float(hi[k] - lo[k]), n_points=int(count[i]),
+                      patch_area=float(min(aL[k], aR[k])),
+                      patch_extent=float(min(eL[k], eR[k])),
+                      torsion_radius=float((rL[k] + rR[k]) / 2), p_WC=p_WC[k], mass=float(mass),
+                      lever=float(lever[k]), force_capacity=force_cap,
+                      torque_capacity=float(torque_cap[k]),
+                      translational_margin=(float(force_cap / f_max[k]) if f_max[k] > 0
+                                            else np.inf),
+                      torsional_margin=(float(torque_cap[k] / tau_max[k]) if tau_max[k] > 0
+                                        else np.inf),
+                      margin=float(1.0 / u_max[k]) if u_max[k] > 0 else np.inf,
+                      squeeze=float(squeeze_force[k]) / force_cap, **cuts[i])
+    return out
 
 
 # --- (c) P(hold | features) ---------------------------------------------------------------------
@@ -522,6 +671,9 @@ def _shipped_model() -> HoldModel:
 # --- the stage: every candidate -----------------------------------------------------------------
 
 
+_BATCH_POINTS = 500_000  # poses × points held in the poses' frames at once (12 MB)
+
+
 @dataclass(frozen=True)
 class Feasibility:
     """Per candidate: P(hold), why it is infeasible ("" if it is not), and its mechanics."""
@@ -543,14 +695,19 @@ def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: n
     mass = hull_volume(target_p_W) * mean_density(category, model.densities,
                                                   config.default_density)
     normals_W = point_normals(target_p_W)
-    p, reasons, holds, hits = [], [], [], []
-    for X in np.asarray(X_WG, float).reshape(-1, 4, 4):
-        h = hold(X, target_p_W=target_p_W, mass=mass, config=config, approach=approach,
-                 normals_W=normals_W)
-        c = collision(X, others_p_W=others_p_W, table_z=table_z, approach=approach,
-                      config=config, closed_width=h.width if h.n_points else None)
-        holds.append(h)
-        hits.append(c)
+    X_WG = np.asarray(X_WG, float).reshape(-1, 4, 4)
+    holds, hits = [], []
+    # The poses a batch at a time, each batch holding the points in every pose's frame.
+    step = max(1, _BATCH_POINTS // max(len(target_p_W), len(others_p_W), 1))
+    for X in (X_WG[i:i + step] for i in range(0, len(X_WG), step)):
+        h = _holds(X, target_p_W=target_p_W, mass=mass, config=config, approach=approach,
+                   normals_W=normals_W)
+        holds += h
+        hits += _collisions(X, others_p_W=others_p_W, table_z=table_z, approach=approach,
+                            config=config,
+                            closed_widths=[g.width if g.n_points else None for g in h])
+    p, reasons = [], []
+    for h, c in zip(holds, hits, strict=True):
         if not c.free:
             reasons.append(f"{COLLISION}the {c.box} would cut another object by "
                            f"{c.depth * 1000:.1f} mm" if c.what == "other object" else
