@@ -38,8 +38,10 @@ from __future__ import annotations
 import copy
 import functools
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
+from pydrake.common import MemoryFile
 from pydrake.common.value import AbstractValue
 from pydrake.geometry import (
     AddCompliantHydroelasticProperties,
@@ -50,6 +52,7 @@ from pydrake.geometry import (
     Convex,
     GeometryInstance,
     GeometrySet,
+    InMemoryMesh,
     MakePhongIllustrationProperties,
     MakeRenderEngineGl,
     Mesh,
@@ -109,6 +112,7 @@ from tg_drake.tasks.contents import (
     ContentsModel,
     DispenserConfig,
     container_sites,
+    contents_wall,
     hopper_height,
     hopper_sites,
 )
@@ -336,6 +340,59 @@ def add_spheres(plant: MultibodyPlant, instance: ModelInstanceIndex, prefix: str
     return tuple(bodies)
 
 
+CONTENTS_WALL = "contents_wall"  # name of an object's simplified surface for the spheres
+
+
+def _obj_text(V: np.ndarray, F: np.ndarray) -> str:
+    return "".join([f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in V]
+                   + [f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F])
+
+
+def add_contents_wall(plant: MultibodyPlant, scene_graph: SceneGraph, body, obj) -> dict:
+    """Before Finalize, in a scene with sphere contents: the library object `obj`'s collision
+    mesh on `body` gets a simplified copy (`tasks.contents.contents_wall`, within WALL_TOLERANCE
+    of it) named CONTENTS_WALL, with the same pose and proximity properties. Returns {the copy's
+    id: the original's name}; `spheres_touch_walls` then lets the spheres touch the copy only,
+    and everything else the original only. Convex pieces (imported objects) are left as they
+    are."""
+    inspector = scene_graph.model_inspector()
+    walls = {}
+    for g in plant.GetCollisionGeometriesForBody(body):
+        shape = inspector.GetShape(g)
+        if not (isinstance(shape, Mesh) and shape.source().is_path()
+                and Path(shape.source().path()).resolve() == obj.mesh_path.resolve()):
+            continue
+        V, F = mesh(obj)[:2]
+        Vw, Fw = contents_wall(V * shape.scale(), F)
+        if len(Fw) >= len(F):
+            continue
+        # (the plant scopes the name by the model instance, as the original's already is)
+        name = f"{inspector.GetName(g).split('::')[-1]}_{CONTENTS_WALL}"
+        wall = Mesh(InMemoryMesh(mesh_file=MemoryFile(_obj_text(Vw, Fw), ".obj", name)))
+        walls[plant.RegisterCollisionGeometry(
+            body, inspector.GetPoseInFrame(g), wall, name,
+            ProximityProperties(inspector.GetProximityProperties(g)))] = inspector.GetName(g)
+    return walls
+
+
+def spheres_touch_walls(plant: MultibodyPlant, scene_graph: SceneGraph,
+                        contents: list[ContentsModel], walls: dict) -> None:
+    """Collision filters (after Finalize): the spheres touch each object's simplified wall and
+    not its original mesh; every other geometry the original and not the wall."""
+    inspector = scene_graph.model_inspector()
+    spheres = {g for m in contents for b in m.bodies
+               for g in plant.GetCollisionGeometriesForBody(plant.get_body(BodyIndex(b)))}
+    # (the originals by name: ids taken before Finalize are not kept)
+    originals = [inspector.GetGeometryIdByName(inspector.GetFrameId(w), Role.kProximity, name)
+                 for w, name in walls.items()]
+    others = set(inspector.GetAllGeometryIds(Role.kProximity)) - spheres - set(walls)
+    manager = scene_graph.collision_filter_manager()
+    manager.Apply(CollisionFilterDeclaration().ExcludeBetween(
+        GeometrySet(list(spheres)), GeometrySet(originals)))
+    manager.Apply(CollisionFilterDeclaration().ExcludeBetween(
+        GeometrySet(list(walls)), GeometrySet(list(others | set(walls)))))
+
+
 def exclude_mutual_contact(plant: MultibodyPlant, scene_graph: SceneGraph,
                            contents: list[ContentsModel]) -> None:
     """Filters contact between any two spheres (after Finalize)."""
@@ -463,6 +520,10 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
         contents.append(dispensed)
     if receiver_of(scenario) is not None:  # a pass: the second WSG (tg_drake.receiver)
         instances[RECEIVER] = add_receiver(plant, parser, scenario)
+    walls = {}
+    for placement in scenario.objects if contents else ():
+        walls.update(add_contents_wall(plant, scene_graph, plant.get_body(
+            plant.GetBodyIndices(objects[placement.instance_name])[0]), get_object(placement.id)))
 
     # Drivers: PD control on the joint actuators (desired state enters the plant).
     for name, driver in scenario.model_drivers.items():
@@ -485,6 +546,8 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
                       instances=instances, objects=objects, cameras={}, contents=contents)
     support_hulls_touch_only_the_table(plant, scene_graph, instances["table"],
                                        list(objects.values()))
+    if walls:
+        spheres_touch_walls(plant, scene_graph, contents, walls)
     if contents and not scenario.contents.mutual:
         exclude_mutual_contact(plant, scene_graph, contents)
     if scenario.dispenser is not None:

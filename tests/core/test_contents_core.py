@@ -8,11 +8,13 @@ from tg_drake.objects import get_object, mesh
 from tg_drake.scenario import load_scenario
 from tg_drake.tasks.contents import (
     CLEARANCE,
+    WALL_TOLERANCE,
     ContentsConfig,
     ContentsModel,
     DispenserConfig,
     cavity_sites,
     container_sites,
+    contents_wall,
     count_contents,
     enclosed,
     hopper_sites,
@@ -134,3 +136,33 @@ def test_hopper_sites_stand_in_the_hopper_apart():
     assert np.all(P[:, 2] >= r)
     gaps = np.linalg.norm(P[:, None] - P[None], axis=2) + np.eye(len(P))
     assert gaps.min() >= 2 * r
+
+
+def _distances(P, V, F):
+    """[m] each point's distance to the triangle mesh (V, F) (open3d's exact distance)."""
+    import open3d as o3d
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.core.Tensor(np.asarray(V, np.float32)),
+                        o3d.core.Tensor(np.asarray(F, np.uint32)))
+    return scene.compute_distance(o3d.core.Tensor(np.asarray(P, np.float32))).numpy()
+
+
+def test_the_wall_the_spheres_touch_is_a_simpler_surface_within_its_tolerance():
+    obj, V, F = _cup()
+    Vw, Fw = contents_wall(V, F)
+    assert len(Fw) < len(F) / 3  # the point of it: far fewer triangles to clip
+    # Both ways within the tolerance (+ float32 round-off): every vertex and triangle centroid of
+    # each surface near the other.
+    tol = WALL_TOLERANCE + 1e-6
+    assert _distances(np.vstack([V, V[F].mean(axis=1)]), Vw, Fw).max() <= tol
+    assert _distances(np.vstack([Vw, Vw[Fw].mean(axis=1)]), V, F).max() <= tol
+    # No sphere starts touching it: the start sites keep their clearance, less the tolerance.
+    config = ContentsConfig(model="spheres")
+    sites = container_sites(obj.id, V, F, config)
+    assert _distances(sites, Vw, Fw).min() >= CLEARANCE * config.radius - tol
+
+
+def test_a_wall_that_cannot_be_simplified_within_its_tolerance_is_the_original():
+    _, V, F = _cup()
+    Vw, Fw = contents_wall(V, F, tolerance=1e-7)
+    assert np.array_equal(Vw, V) and np.array_equal(Fw, F)

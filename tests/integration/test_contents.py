@@ -14,7 +14,7 @@ from pydrake.systems.analysis import Simulator
 from tg_drake.objects import WATER_DENSITY, get_object
 from tg_drake.scenario import load_scenario
 from tg_drake.simulation.pour import tilt_rig
-from tg_drake.station import make_station
+from tg_drake.station import CONTENTS_WALL, make_station
 from tg_drake.tasks.contents import ContentsConfig, count_contents
 
 CUP = "cup_01"
@@ -58,6 +58,29 @@ cameras: {{}}
     simulator.AdvanceTo(1.0)
     (after,) = _station_counts(diagram, station, context, {CUP: CUP})
     assert after == {CUP: len(model.bodies), "table": 0, "floor": 0, "elsewhere": 0}
+
+
+def test_the_spheres_touch_the_simplified_wall_and_everything_else_the_original_mesh():
+    scenario = load_scenario(scenario_text=f"""
+objects: [{{id: {CUP}, xy: [0.0, 0.2], containment: full}}]
+contents: {{model: spheres}}
+cameras: {{}}
+""")
+    _, station = make_station(scenario)
+    plant, inspector = station.plant, station.scene_graph.model_inspector()
+    (model,) = station.contents
+    body = station.object_body(CUP)
+    names = {inspector.GetName(g): g for g in plant.GetCollisionGeometriesForBody(body)}
+    (wall,) = [g for n, g in names.items() if n.endswith(CONTENTS_WALL)]
+    original = names[inspector.GetName(wall).removesuffix(f"_{CONTENTS_WALL}")]
+    sphere = plant.GetCollisionGeometriesForBody(plant.get_body(BodyIndex(model.bodies[0])))[0]
+    pad = next(g for g in inspector.GetAllGeometryIds()
+               if "finger" in inspector.GetName(g) and inspector.GetProximityProperties(g))
+    assert not inspector.CollisionFiltered(sphere, wall)
+    assert inspector.CollisionFiltered(sphere, original)
+    assert not inspector.CollisionFiltered(pad, original)
+    assert inspector.CollisionFiltered(pad, wall)
+    assert inspector.GetPoseInFrame(wall).IsExactlyEqualTo(inspector.GetPoseInFrame(original))
 
 
 def test_the_mass_model_adds_no_spheres():

@@ -31,7 +31,7 @@ from tg_drake.objects import WATER_DENSITY, get_object, mesh
 from tg_drake.robot import WSG_MAX_OPENING
 from tg_drake.scenario import ObjectPlacement, Scenario, default_plant_config
 from tg_drake.simulation.scripted import drive_station, side_grasp_configurations
-from tg_drake.station import add_spheres
+from tg_drake.station import add_contents_wall, add_spheres, spheres_touch_walls
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, add_table
 from tg_drake.tasks.contents import ContentsConfig, ContentsModel, container_sites, count_contents
 
@@ -63,7 +63,7 @@ def tilt_rig(obj_id: str, config: ContentsConfig, *, pivot_height: float = 0.25,
     through the plant's PD control. Gravity is off for the link and the container (held as a
     robot would hold it), on for the spheres."""
     builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlant(plant_config or default_plant_config(), builder)
+    plant, scene_graph = AddMultibodyPlant(plant_config or default_plant_config(), builder)
     add_table(plant, TABLE_SIZE, X_WT_DEFAULT)
     obj = get_object(obj_id)
     (instance,) = make_parser(plant).AddModels(url=obj.sdf_url)
@@ -83,12 +83,15 @@ def tilt_rig(obj_id: str, config: ContentsConfig, *, pivot_height: float = 0.25,
     p_W = p_O + (X_WP @ X_LO).translation()
     bodies = add_spheres(plant, plant.AddModelInstance("spheres"), "sphere", p_W, config.radius,
                          WATER_DENSITY * obj.cavity_volume / len(p_O), config)
+    walls = add_contents_wall(plant, scene_graph, body, obj)
     plant.Finalize()
+    model = ContentsModel(obj.id, bodies, config.radius)
+    spheres_touch_walls(plant, scene_graph, [model], walls)
     ramp = PiecewisePolynomial.FirstOrderHold([0.0, duration, duration + 1e3],
                                               [[0.0, turn, turn]])
     source = builder.AddSystem(TrajectorySource(ramp, output_derivative_order=1))
     builder.Connect(source.get_output_port(), plant.get_desired_state_input_port(instance))
-    return Rig(builder.Build(), plant, body, ContentsModel(obj.id, bodies, config.radius))
+    return Rig(builder.Build(), plant, body, model)
 
 
 @dataclass
