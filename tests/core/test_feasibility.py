@@ -18,8 +18,10 @@ from tg_drake.grasping.feasibility import (
     load_hold_model,
     mean_density,
     point_normals,
+    why_no_pose,
 )
 from tg_drake.robot import WSG_MAX_OPENING, WSG_PAD_SIZE
+from tg_drake.types import GraspCandidates
 
 CONFIG = FeasibilityConfig()
 
@@ -240,3 +242,23 @@ def test_the_assessed_candidates_keep_the_scorers_score(monkeypatch):
                                         config=FeasibilityConfig())
     assert np.allclose(out.score, [0.9, 0.8, 0.5, 0.0])  # the third is infeasible: 0, last
     assert out.source.tolist() == [0, 1, 3, 2]
+
+
+def test_why_no_pose_counts_each_favoured_parts_refusals_by_class():
+    n = 6
+    candidates = GraspCandidates(
+        np.tile(np.eye(4), (n, 1, 1)), np.array([1, 1, 1, 1, 2, 0]), np.array([0.9] * 4 + [0.1, 0]),
+        np.array([0.8, 0.8, 0.8, 0.0, 0.5, 0.5]), np.zeros(n),
+        feasibility_reasons=("does not fit: middle is 0.13 m across the fingers",
+                             "does not fit: middle is 0.12 m across the fingers",
+                             "collision: the housing would cut another object by 3 mm", "",
+                             "would not hold: the lever", ""))
+    why = why_no_pose(candidates, {"middle": 0.9, "bottom": 0.1, "top": 0.0})
+    assert why == ("middle (P(part | task) 0.90): 4 poses, none feasible — does not fit 2, "
+                   "collision 1, P(grasp | local shape) = 0 1 (e.g. does not fit: middle is "
+                   "0.13 m across the fingers); bottom (P(part | task) 0.10): 1 poses, none "
+                   "feasible — would not hold 1 (e.g. would not hold: the lever)")
+    # A favoured part without poses is said so; unfavoured parts are left out.
+    assert why_no_pose(candidates, {"handle": 1.0}) == (
+        "handle (P(part | task) 1.00): no pose was made on it")
+    assert why_no_pose(candidates, {"top": 0.0}) == ""

@@ -789,3 +789,32 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
                            feasibility_reasons=tuple(reasons[j] for j in order),
                            source=source[order], unholdable_parts=unholdable,
                            holds=tuple(f.holds[j] for j in order))
+
+
+def why_no_pose(candidates: GraspCandidates, part_probability: dict[str, float], *,
+                parts: int = 2) -> str:
+    """Why none of the candidates can be tried, for a user: for each of the (at most `parts`)
+    parts the logic favours most (P(part | task) ≥ 0.01), its poses and why they were refused,
+    counted by class (a reason's text up to its first colon: "does not fit", "collision",
+    "would not hold", ...), the most common class quoted once. A pose refused by no reason was
+    scored 0 by the scorer. "" when the logic favours no part."""
+    labels = np.asarray(candidates.parts, int)
+    reasons = candidates.feasibility_reasons or ("",) * len(labels)
+    p_local = np.asarray(candidates.p_local, float)
+    out = []
+    for name, p in sorted(part_probability.items(), key=lambda kv: -kv[1])[:parts]:
+        if p < 0.01:
+            break
+        rows = np.flatnonzero(labels == PART_LABELS.index(name))
+        if not len(rows):
+            out.append(f"{name} (P(part | task) {p:.2f}): no pose was made on it")
+            continue
+        by_class: dict[str, list[str]] = {}
+        for j in rows:
+            r = reasons[j] or ("P(grasp | local shape) = 0" if p_local[j] <= 0 else "scored 0")
+            by_class.setdefault(r.split(":")[0], []).append(r)
+        ranked = sorted(by_class.items(), key=lambda kv: -len(kv[1]))
+        counts = ", ".join(f"{cls} {len(rs)}" for cls, rs in ranked)
+        out.append(f"{name} (P(part | task) {p:.2f}): {len(rows)} poses, none feasible — "
+                   f"{counts} (e.g. {ranked[0][1][0]})")
+    return "; ".join(out)

@@ -53,6 +53,7 @@ from tg_drake.errors import (
     SimulationError,
     TgDrakeError,
 )
+from tg_drake.grasping.feasibility import why_no_pose
 from tg_drake.outcome import (
     HandGeometries,
     contact_pairs,
@@ -474,8 +475,10 @@ class Supervisor(LeafSystem):
             if grasps.unholdable_parts:
                 reason = Reason.would_not_hold
                 told += f"; no grasp on {', '.join(grasps.unholdable_parts)} would hold"
+            why = why_no_pose(grasps, semantics.part)
             return self._finish(memory, Status.failed, reason,
-                                f"no pre-grasp hypothesis with a non-zero score{told}")
+                                f"no pre-grasp hypothesis with a non-zero score"
+                                f"{': ' + why if why else ''}{told}")
         return dataclasses.replace(memory, phase=Phase.planning, attempt=memory.attempt + 1)
 
     def _await_plan(self, context, memory: _Memory) -> _Memory:
