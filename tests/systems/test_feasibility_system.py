@@ -3,7 +3,8 @@ small diagram: fixed scene, semantics and scored candidates in, executed poses w
 
 import numpy as np
 import pytest
-from pydrake.systems.framework import DiagramBuilder
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from tg_drake.grasping.feasibility import FeasibilityConfig
 from tg_drake.robot import WSG_GRASP_POINT_G
@@ -90,3 +91,43 @@ def test_feasibility_system_rules_out_the_pose_that_would_cut_a_neighbour(scene,
     assert out.score[best] == pytest.approx(1.0 * 0.8 * p_hold)
     assert 0.0 < out.p_hold[best] <= 1.0
     assert np.all(np.diff(out.score) <= 0)  # best first
+
+
+class Held(LeafSystem):
+    """Gives its `values` (name -> Python object) on output ports of those names, as an upstream
+    stage gives its cached answer: the same object until it changes. Their prerequisites are the
+    defaults (time among them), so every new time makes them, and all below, out of date."""
+
+    def __init__(self, values: dict):
+        super().__init__()
+        self.values = dict(values)
+        for name, value in values.items():
+            self.DeclareAbstractOutputPort(
+                name, lambda v=value: AbstractValue.Make(v),
+                lambda context, output, name=name: output.set_value(self.values[name]))
+
+
+def test_the_stage_answers_again_without_recomputing_while_its_inputs_are_the_same(scene):
+    semantics = GraspSemantics(category={"can": 1.0}, task={}, part={"middle": 1.0},
+                               given_task=None)
+    builder = DiagramBuilder()
+    held = builder.AddSystem(Held({"scene_description": scene, "grasp_semantics": semantics,
+                                   "ranked_grasps": candidates()}))
+    system = builder.AddSystem(GraspFeasibility(FeasibilityConfig()))
+    for name in ("scene_description", "grasp_semantics", "ranked_grasps"):
+        builder.Connect(held.GetOutputPort(name), system.GetInputPort(name))
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    port = system.get_ranked_grasps_output_port()
+    answers = []
+    for t in (0.0, 0.1, 0.2):  # a new time: the port is out of date, its inputs the same objects
+        context.SetTime(t)
+        answers.append(port.Eval(system.GetMyContextFromRoot(context)))
+    first = answers[0]
+    assert all(a is first for a in answers) and system._last.computed == 1
+    # Other candidates (an equal copy is another object): computed again, the same answer.
+    held.values["ranked_grasps"] = candidates()
+    context.SetTime(0.3)
+    again = port.Eval(system.GetMyContextFromRoot(context))
+    assert system._last.computed == 2 and again is not first
+    np.testing.assert_array_equal(again.score, first.score)

@@ -14,6 +14,7 @@ from tg_drake.grasping.scoring import (
     local_probabilities,
     rank_grasps,
 )
+from tg_drake.systems.memo import LastResult
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 
@@ -53,6 +54,7 @@ class DgiScoringSystem(LeafSystem):
                  part: str | None = None, expansion: ExpansionConfig | None = None,
                  approach: float = DEFAULT_APPROACH, seed: int = 0):
         super().__init__()
+        self._last = LastResult()  # the stage's last answer and its inputs
         check_selection(selection, part)
         self._expansion = expansion or ExpansionConfig()
         self._approach = float(approach)
@@ -113,7 +115,8 @@ class DgiScoringSystem(LeafSystem):
         semantics: GraspSemantics = self._semantics_port.Eval(context)
         cached = self._p_local.Eval(context)
         p_local = cached[1] if cached is not None and cached[0] == semantics.target else None
-        output.set_value(rank_grasps(self._scene_port.Eval(context), semantics, self._model,
-                                     selection=self._selection, part=self._part,
-                                     p_local=p_local, expansion=self._expansion,
-                                     approach=self._approach, seed=self._seed))
+        scene = self._scene_port.Eval(context)
+        output.set_value(self._last((scene, semantics, cached), lambda: rank_grasps(
+            scene, semantics, self._model, selection=self._selection, part=self._part,
+            p_local=p_local, expansion=self._expansion, approach=self._approach,
+            seed=self._seed)))

@@ -7,6 +7,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
 from tg_drake.grasping.feasibility import FeasibilityConfig, assess_candidates, load_hold_model
+from tg_drake.systems.memo import LastResult
 from tg_drake.types import GraspCandidates, GraspSemantics, SceneDescription
 
 
@@ -42,6 +43,7 @@ class GraspFeasibility(LeafSystem):
 
     def __init__(self, config: FeasibilityConfig | None = None, *, approach: float = 0.10):
         super().__init__()
+        self._last = LastResult()  # the stage's last answer and its inputs
         self._config = config or FeasibilityConfig()
         self._model = load_hold_model(self._config.model or None)
         self._approach = float(approach)
@@ -62,7 +64,7 @@ class GraspFeasibility(LeafSystem):
 
     def _calc(self, context, output):
         semantics: GraspSemantics = self._semantics_port.Eval(context)
-        output.set_value(assess_candidates(
-            self._scene_port.Eval(context), self._grasps_port.Eval(context),
-            category=semantics.category or None, approach=self._approach, config=self._config,
-            model=self._model))
+        scene, grasps = self._scene_port.Eval(context), self._grasps_port.Eval(context)
+        output.set_value(self._last((scene, semantics, grasps), lambda: assess_candidates(
+            scene, grasps, category=semantics.category or None, approach=self._approach,
+            config=self._config, model=self._model)))

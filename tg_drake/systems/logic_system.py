@@ -9,6 +9,7 @@ from pydrake.systems.framework import LeafSystem
 from tg_drake.errors import RuleError
 from tg_drake.logic.engine import LogicEngine, LogicQueryConfig
 from tg_drake.logic.observations import Observations
+from tg_drake.systems.memo import LastResult
 from tg_drake.types import CategoryPrior, GraspSemantics, SceneDescription
 
 
@@ -43,6 +44,7 @@ class LogicQuerySystem(LeafSystem):
 
     def __init__(self, config: LogicQueryConfig | None = None):
         super().__init__()
+        self._last = LastResult()  # the stage's last answer and its inputs
         self._config = config if config is not None else LogicQueryConfig()
         self._engine = LogicEngine(self._config.theory())
         self._scene_port = self.DeclareAbstractInputPort(
@@ -114,11 +116,16 @@ class LogicQuerySystem(LeafSystem):
         if isinstance(no_hold, str) or not isinstance(no_hold, tuple | list):
             raise RuleError(f"no_hold must be a tuple of part names, got {no_hold!r}",
                             field="no_hold")
-        obs = Observations.from_object(scene.objects[target], prior=prior, task=task,
-                                       collisions=tuple(collisions), no_hold=tuple(no_hold),
-                                       prior_floor=self._config.prior_floor)
-        answer = self._engine.query(obs, explain=self._config.explain)
-        output.set_value(answer.to_semantics(target=target))
+        collisions, no_hold = tuple(collisions), tuple(no_hold)
+
+        def answer():
+            obs = Observations.from_object(scene.objects[target], prior=prior, task=task,
+                                           collisions=collisions, no_hold=no_hold,
+                                           prior_floor=self._config.prior_floor)
+            return self._engine.query(obs, explain=self._config.explain).to_semantics(
+                target=target)
+
+        output.set_value(self._last((scene, prior, task, collisions, no_hold), answer))
 
 
 class TaskSource(LeafSystem):
