@@ -196,6 +196,8 @@ def test_the_gate_is_checked_again_after_a_requery():
     assert (o.status, o.reason, o.requeries, o.unreachable_parts) == (
         "failed", "unreachable", 1, ("bottom",))
     assert "P(some part is grasped) = 0.010" in o.detail and "bottom" in o.detail
+    # Why the bottom cannot be reached: the planner's reason, which the logic never hears.
+    assert "told bottom cannot be reached: pre-grasp pose unreachable (test)" in o.detail
     assert f.request.attempt == 1
 
 

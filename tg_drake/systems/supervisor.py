@@ -456,7 +456,9 @@ class Supervisor(LeafSystem):
         reason, told = Reason.logic, ""
         if memory.collisions:
             reason = Reason.unreachable
-            told = f", told {', '.join(memory.collisions)} cannot be reached"
+            # Why it cannot be reached: the planner's words (the logic only hears the part).
+            told = (f", told {', '.join(memory.collisions)} cannot be reached"
+                    + (f": {_why(memory.failures)}" if memory.failures else ""))
         if memory.no_hold:
             reason = Reason.unreachable if memory.collisions else Reason.would_not_hold
             told += f", told no grasp on {', '.join(memory.no_hold)} would hold"
