@@ -1,8 +1,8 @@
 """The contents of containers as free spheres: where they start, and where they end up.
 
-A core (numpy only, no Drake systems framework). The station (tg_drake.station) builds the
-spheres from `ContentsConfig`/`DispenserConfig` and start positions computed here; the task check
-counts them with `count_contents`.
+A core (NumPy, and Open3D for the wall the spheres touch; no Drake systems framework). The
+station (tg_drake.station) builds the spheres from `ContentsConfig`/`DispenserConfig` and start
+positions computed here; the task check counts them with `count_contents`.
 
 "Inside a container" is decided from the container's own mesh in its frame O, not from a box: a
 point is inside when it lies outside the container's solid and the mesh closes it in sideways and
@@ -19,6 +19,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import open3d as o3d
 
 from tg_drake.errors import ScenarioError
 from tg_drake.objects import mesh as object_mesh
@@ -431,8 +432,6 @@ WALL_TOLERANCE = 0.001  # [m] a sphere's radius / 8 at the default radius: well 
 def _hausdorff(V0, F0, V1, F1) -> float:
     """[m] symmetric distance between two triangle meshes, over vertices and triangle centroids
     (open3d's exact point-to-triangle distance)."""
-    import open3d as o3d
-
     def far(Va, Fa, Vb, Fb) -> float:
         scene = o3d.t.geometry.RaycastingScene()
         scene.add_triangles(o3d.core.Tensor(Vb.astype(np.float32)),
@@ -445,8 +444,6 @@ def _hausdorff(V0, F0, V1, F1) -> float:
 
 @functools.lru_cache(maxsize=64)
 def _wall_cached(V_bytes: bytes, F_bytes: bytes, tolerance: float):
-    import open3d as o3d
-
     V = np.frombuffer(V_bytes, float).reshape(-1, 3)
     F = np.frombuffer(F_bytes, np.int64).reshape(-1, 3)
     source = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(V.copy()),
