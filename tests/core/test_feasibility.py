@@ -262,3 +262,10 @@ def test_why_no_pose_counts_each_favoured_parts_refusals_by_class():
     assert why_no_pose(candidates, {"handle": 1.0}) == (
         "handle (P(part | task) 1.00): no pose was made on it")
     assert why_no_pose(candidates, {"top": 0.0}) == ""
+    # A part whose poses mostly scored 0 quotes a refusal's own words, not "scored 0".
+    mostly_zero = GraspCandidates(
+        np.tile(np.eye(4), (3, 1, 1)), np.array([3, 3, 3]), np.ones(3), np.array([0.5] * 3),
+        np.zeros(3), feasibility_reasons=("", "", "would not hold: the lever"))
+    assert why_no_pose(mostly_zero, {"handle": 0.8}) == (
+        "handle (P(part | task) 0.80): 3 poses, none feasible — scored 0 2, would not hold 1 "
+        "(e.g. would not hold: the lever)")

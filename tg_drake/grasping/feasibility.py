@@ -791,6 +791,9 @@ def assess_candidates(scene: SceneDescription, candidates: GraspCandidates, *,
                            holds=tuple(f.holds[j] for j in order))
 
 
+UNSAID = ("P(grasp | local shape) = 0", "scored 0")  # a pose no refusal names: why it scored 0
+
+
 def why_no_pose(candidates: GraspCandidates, part_probability: dict[str, float], *,
                 parts: int = 2) -> str:
     """Why none of the candidates can be tried, for a user: for each of the (at most `parts`)
@@ -811,10 +814,12 @@ def why_no_pose(candidates: GraspCandidates, part_probability: dict[str, float],
             continue
         by_class: dict[str, list[str]] = {}
         for j in rows:
-            r = reasons[j] or ("P(grasp | local shape) = 0" if p_local[j] <= 0 else "scored 0")
+            r = reasons[j] or UNSAID[int(p_local[j] > 0)]
             by_class.setdefault(r.split(":")[0], []).append(r)
         ranked = sorted(by_class.items(), key=lambda kv: -len(kv[1]))
         counts = ", ".join(f"{cls} {len(rs)}" for cls, rs in ranked)
+        # The quote: a refusal's own words where there are any (a score of 0 says nothing more).
+        quote = next((rs[0] for cls, rs in ranked if cls not in UNSAID), ranked[0][1][0])
         out.append(f"{name} (P(part | task) {p:.2f}): {len(rows)} poses, none feasible — "
-                   f"{counts} (e.g. {ranked[0][1][0]})")
+                   f"{counts} (e.g. {quote})")
     return "; ".join(out)
