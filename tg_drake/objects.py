@@ -429,6 +429,14 @@ def _mesh(directory: Path, obj_id: str):
     return V, F, labels
 
 
+def obj_text(V: np.ndarray, F: np.ndarray, *, name: str, comment: str) -> str:
+    """Wavefront OBJ of the triangles (V, F) (V [m] at 1 nm, F 0-based): the `v` and `f` lines
+    `mesh` reads, under a `# {name}: {comment}` line and an object named `name`."""
+    v = "\n".join(f"v {x:.9f} {y:.9f} {z:.9f}" for x, y, z in np.asarray(V, float).tolist())
+    f = "\n".join(f"f {a} {b} {c}" for a, b, c in (np.asarray(F) + 1).tolist())
+    return f"# {name}: {comment}\no {name}\n{v}\n{f}\n"
+
+
 def mesh(obj: LibraryObject | str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(vertices (V, 3) [m] in O, triangles (F, 3) int, part label per vertex (V,) uint8).
 

@@ -91,7 +91,7 @@ from pydrake.systems.sensors import ApplyCameraConfig, CameraConfig, CameraInfo,
 
 from tg_drake.errors import ModelError, ScenarioError, unknown_name
 from tg_drake.models import make_parser
-from tg_drake.objects import get_object, mesh
+from tg_drake.objects import get_object, mesh, obj_text
 from tg_drake.receiver import RECEIVER, add_receiver, connect_receiver, receiver_of
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
 from tg_drake.robot_plants import add_scenario_models
@@ -343,11 +343,6 @@ def add_spheres(plant: MultibodyPlant, instance: ModelInstanceIndex, prefix: str
 CONTENTS_WALL = "contents_wall"  # name of an object's simplified surface for the spheres
 
 
-def _obj_text(V: np.ndarray, F: np.ndarray) -> str:
-    return "".join([f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in V]
-                   + [f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F])
-
-
 def add_contents_wall(plant: MultibodyPlant, scene_graph: SceneGraph, body, obj) -> dict:
     """Before Finalize, in a scene with sphere contents: the library object `obj`'s collision
     mesh on `body` gets a simplified copy (`tasks.contents.contents_wall`, within WALL_TOLERANCE
@@ -368,7 +363,8 @@ def add_contents_wall(plant: MultibodyPlant, scene_graph: SceneGraph, body, obj)
             continue
         # (the plant scopes the name by the model instance, as the original's already is)
         name = f"{inspector.GetName(g).split('::')[-1]}_{CONTENTS_WALL}"
-        wall = Mesh(InMemoryMesh(mesh_file=MemoryFile(_obj_text(Vw, Fw), ".obj", name)))
+        text = obj_text(Vw, Fw, name=name, comment="the surface the spheres touch (metres, O)")
+        wall = Mesh(InMemoryMesh(mesh_file=MemoryFile(text, ".obj", name)))
         walls[plant.RegisterCollisionGeometry(
             body, inspector.GetPoseInFrame(g), wall, name,
             ProximityProperties(inspector.GetProximityProperties(g)))] = inspector.GetName(g)
@@ -520,10 +516,10 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
         contents.append(dispensed)
     if receiver_of(scenario) is not None:  # a pass: the second WSG (tg_drake.receiver)
         instances[RECEIVER] = add_receiver(plant, parser, scenario)
-    walls = {}
+    walls = {}  # with spheres, each object's simplified wall for them
     for placement in scenario.objects if contents else ():
-        walls.update(add_contents_wall(plant, scene_graph, plant.get_body(
-            plant.GetBodyIndices(objects[placement.instance_name])[0]), get_object(placement.id)))
+        body = plant.get_body(plant.GetBodyIndices(objects[placement.instance_name])[0])
+        walls.update(add_contents_wall(plant, scene_graph, body, get_object(placement.id)))
 
     # Drivers: PD control on the joint actuators (desired state enters the plant).
     for name, driver in scenario.model_drivers.items():

@@ -19,6 +19,11 @@ from tg_drake.tasks.contents import ContentsConfig, count_contents
 
 CUP = "cup_01"
 BOWL = "bowl_01"
+FULL_CUP = f"""
+objects: [{{id: {CUP}, xy: [0.0, 0.2], containment: full}}]
+contents: {{model: spheres}}
+cameras: {{}}
+"""  # a full cup of spheres on the table, no camera
 
 
 def _hold_robot(diagram, station, context):
@@ -38,11 +43,7 @@ def _station_counts(diagram, station, context, containers):
 
 
 def test_a_full_cup_standing_for_1_s_keeps_every_sphere():
-    scenario = load_scenario(scenario_text=f"""
-objects: [{{id: {CUP}, xy: [0.0, 0.2], containment: full}}]
-contents: {{model: spheres}}
-cameras: {{}}
-""")
+    scenario = load_scenario(scenario_text=FULL_CUP)
     diagram, station = make_station(scenario)
     (model,) = station.contents
     assert model.name == CUP and len(model.bodies) > 0
@@ -61,11 +62,7 @@ cameras: {{}}
 
 
 def test_the_spheres_touch_the_simplified_wall_and_everything_else_the_original_mesh():
-    scenario = load_scenario(scenario_text=f"""
-objects: [{{id: {CUP}, xy: [0.0, 0.2], containment: full}}]
-contents: {{model: spheres}}
-cameras: {{}}
-""")
+    scenario = load_scenario(scenario_text=FULL_CUP)
     _, station = make_station(scenario)
     plant, inspector = station.plant, station.scene_graph.model_inspector()
     (model,) = station.contents

@@ -20,6 +20,7 @@ import coacd  # after open3d: open3d fails to load (std::bad_cast) in a process 
 
 from tg_drake.errors import ModelError
 from tg_drake.importing.mesh import boundary_edges, closed_with_caps
+from tg_drake.objects import obj_text
 
 # Parameters of each backend, in its own units.
 BACKENDS: dict[str, dict] = {
@@ -113,11 +114,10 @@ def _hull(points: np.ndarray) -> ConvexPiece | None:
 
 
 def piece_obj_text(piece: ConvexPiece, name: str) -> str:
-    """Wavefront OBJ of a piece (metres, O)."""
-    # 1 nm: a hull's near-coplanar facets stay convex when read back
-    v = "\n".join(f"v {x:.9f} {y:.9f} {z:.9f}" for x, y, z in piece.vertices.tolist())
-    f = "\n".join(f"f {a} {b} {c}" for a, b, c in (piece.faces + 1).tolist())
-    return f"# {name}: convex collision piece (metres, object frame O)\no {name}\n{v}\n{f}\n"
+    """Wavefront OBJ of a piece (metres, O; 1 nm: a hull's near-coplanar facets stay convex when
+    read back)."""
+    return obj_text(piece.vertices, piece.faces, name=name,
+                    comment="convex collision piece (metres, object frame O)")
 
 
 def collision_sdf(uris: list[str], *, mu: float = 1.0) -> str:

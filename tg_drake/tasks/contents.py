@@ -429,17 +429,18 @@ WALL_TOLERANCE = 0.001  # [m] a sphere's radius / 8 at the default radius: well 
 # 3–6 mm thickness, so no wall opens and no cavity shrinks by more than this
 
 
-def _hausdorff(V0, F0, V1, F1) -> float:
-    """[m] symmetric distance between two triangle meshes, over vertices and triangle centroids
-    (open3d's exact point-to-triangle distance)."""
-    def far(Va, Fa, Vb, Fb) -> float:
-        scene = o3d.t.geometry.RaycastingScene()
-        scene.add_triangles(o3d.core.Tensor(Vb.astype(np.float32)),
-                            o3d.core.Tensor(Fb.astype(np.uint32)))
-        q = np.vstack([Va, Va[Fa].mean(axis=1)]).astype(np.float32)
-        return float(scene.compute_distance(o3d.core.Tensor(q)).numpy().max())
+def _distance_to(V: np.ndarray, F: np.ndarray):
+    """points (n, 3) → the largest of their distances [m] to the triangle mesh (V, F) (open3d's
+    exact point-to-triangle distance); the mesh's scene is built once."""
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.core.Tensor(V.astype(np.float32)), o3d.core.Tensor(F.astype(np.uint32)))
+    return lambda P: float(scene.compute_distance(o3d.core.Tensor(P.astype(np.float32))).numpy()
+                           .max())
 
-    return max(far(V0, F0, V1, F1), far(V1, F1, V0, F0))
+
+def _samples(V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """The points a mesh is compared by: its vertices and its triangles' centroids."""
+    return np.vstack([V, V[F].mean(axis=1)])
 
 
 @functools.lru_cache(maxsize=64)
@@ -448,6 +449,7 @@ def _wall_cached(V_bytes: bytes, F_bytes: bytes, tolerance: float):
     F = np.frombuffer(F_bytes, np.int64).reshape(-1, 3)
     source = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(V.copy()),
                                        o3d.utility.Vector3iVector(F.astype(np.int32)))
+    to_original, original = _distance_to(V, F), _samples(V, F)
     best = (V, F)
     lo, hi = 4, len(F)  # the fewest triangles within the tolerance, by bisection
     while hi - lo > max(8, hi // 20):
@@ -456,7 +458,9 @@ def _wall_cached(V_bytes: bytes, F_bytes: bytes, tolerance: float):
         d.remove_degenerate_triangles()
         d.remove_unreferenced_vertices()
         Vd, Fd = np.asarray(d.vertices, float), np.asarray(d.triangles, np.int64)
-        if len(Fd) and _hausdorff(V, F, Vd, Fd) <= tolerance:
+        # Within the tolerance both ways (a symmetric distance over the samples).
+        if (len(Fd) and to_original(_samples(Vd, Fd)) <= tolerance
+                and _distance_to(Vd, Fd)(original) <= tolerance):
             best, hi = (Vd, Fd), n
         else:
             lo = n
