@@ -5,8 +5,11 @@ These checks take what the plant's output ports give (``contact_results``: a `Co
 bodies involved (`HandGeometries`, read once from the finalized plant's model). They are the
 ground truth of an execution, never inputs to the pipeline's perception or reasoning.
 
-The one rule for "held" is `is_held`: both finger pads touch the object and the fingers stand more
-than `CLOSED_ON_AIR` apart.
+The one rule for "held" is `is_held`: the object pushes each finger pad outwards, away from the
+other, with at least `MIN_SQUEEZE` — it is squeezed between the pads' inner faces. The contact
+forces say so whatever the object's thickness: a 1.5 mm knife blade squeezed by the compliant pads
+(which sink into it ~1.4 mm) leaves the fingers under a millimetre apart and is held, while fingers
+closed on air with the object pressing on their outsides feel a push inwards.
 """
 
 from __future__ import annotations
@@ -15,12 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# The closed-on-air tolerance of every "held" check in tg_drake (the run's outcomes, the training
-# episodes' labels, the scripted grasp): a finger opening (distance between the pads' inner
-# faces) at or below this means the fingers closed on air, whatever touches their outsides [m].
-# Pads that close on nothing stop at 0 (each finger's joint limit; measured −0.03 mm in a grasp
-# episode); 1 mm is well above that and under the thinnest walls the library's objects offer the
-# pads (a pot's rim, 1–1.5 mm; a bowl's 4–5 mm wall leaves the squeezing pads about 4 mm apart).
+# [N] the least push of the object on each pad, outwards along the closing axis, for "squeezed
+# between the pads" (every "held" check in tg_drake: the run's outcomes, the receiver's hold, the
+# training episodes' labels, the scripted grasp). A closing WSG presses with its force limit (tens
+# of newtons, `tg_drake.robot.WSG_FORCE_LIMIT`); an object that only grazes a pad's edge or rests
+# on its end face pushes it sideways by a few millinewtons of solver noise along the axis. 1 N is
+# far from both.
+MIN_SQUEEZE = 1.0
+# [m] fingers at or below this opening (between the pads' inner faces) have closed fully: said
+# in reasons, not used for "held" (pads that close on nothing stop at 0, each finger's limit).
 CLOSED_ON_AIR = 0.001
 # Placement tolerances: distance of the object's centre from the place target on the table [m],
 # tilt of its axis from the pose it was picked in [rad].
@@ -28,20 +34,23 @@ PLACE_XY_TOLERANCE = 0.05
 PLACE_TILT_TOLERANCE = np.deg2rad(20)
 
 
-def is_held(touches_left: bool, touches_right: bool, opening: float) -> bool:
-    """The one rule for "the gripper holds the object": both pads touch it and the fingers are
-    more than `CLOSED_ON_AIR` apart (`opening` [m], between the pads' inner faces)."""
-    return bool(touches_left and touches_right and opening > CLOSED_ON_AIR)
+def is_held(squeeze_left: float, squeeze_right: float) -> bool:
+    """The one rule for "the gripper holds the object": it pushes each pad outwards (away from
+    the other pad, along the closing axis) with at least `MIN_SQUEEZE` [N]."""
+    return bool(squeeze_left >= MIN_SQUEEZE and squeeze_right >= MIN_SQUEEZE)
 
 
 @dataclass(frozen=True)
 class HandGeometries:
-    """Collision geometry ids of the target object, the two WSG fingers and the table."""
+    """Collision geometry ids of the target object, the two WSG fingers and the table, and the
+    index of the WSG's body (its frame's x axis is the closing axis: the right finger opens
+    along +x, the left along −x)."""
 
     object: frozenset
     left: frozenset
     right: frozenset
     table: frozenset
+    gripper: int = -1
 
     @classmethod
     def from_plant(cls, plant, *, object_body, wsg_instance, table_instance) -> HandGeometries:
@@ -52,7 +61,8 @@ class HandGeometries:
                           for g in plant.GetCollisionGeometriesForBody(plant.get_body(b)))
         return cls(object=of(object_body),
                    left=of(plant.GetBodyByName("left_finger", wsg_instance)),
-                   right=of(plant.GetBodyByName("right_finger", wsg_instance)), table=table)
+                   right=of(plant.GetBodyByName("right_finger", wsg_instance)), table=table,
+                   gripper=int(plant.GetBodyByName("body", wsg_instance).index()))
 
 
 @dataclass
@@ -61,10 +71,20 @@ class HandContact:
     left: bool  # the left pad touches the object
     right: bool  # the right pad touches the object
     hydroelastic: int  # hydroelastic contact surfaces on the object
+    squeeze_left: float = 0.0  # [N] the object's push on the left pad, outwards (along −x_G)
+    squeeze_right: float = 0.0  # [N] the object's push on the right pad, outwards (along +x_G)
 
     @property
     def held(self) -> bool:
-        return is_held(self.left, self.right, self.opening)
+        return is_held(self.squeeze_left, self.squeeze_right)
+
+    def describe(self) -> str:
+        """The pads' state in words, for a reason: which pads touch, how hard the object pushes
+        them apart, how far apart the fingers stand."""
+        return (f"left pad {'touching' if self.left else 'free'}, right pad "
+                f"{'touching' if self.right else 'free'}, pushed apart "
+                f"{self.squeeze_left:.1f} N / {self.squeeze_right:.1f} N (held from "
+                f"{MIN_SQUEEZE:.0f} N each), fingers {self.opening * 1000:.1f} mm apart")
 
 
 def contact_pairs(contact_results) -> list[tuple]:
@@ -80,22 +100,48 @@ def contact_pairs(contact_results) -> list[tuple]:
     return pairs
 
 
-def hand_contact(contact_results, *, wsg_q, geometries: HandGeometries) -> HandContact:
-    """Which finger pads touch the object; `wsg_q` = (q_left, q_right) [m], the first two entries
-    of the station's ``wsg.state``."""
-    touches_left = touches_right = False
+def forces_on(contact_results, *, on: frozenset, by: frozenset) -> list[np.ndarray]:
+    """The contact forces [N] (world frame) on the geometries `on` from the geometries `by`, one
+    per hydroelastic surface or point pair between them. Drake gives a hydroelastic surface's
+    force on the body of its geometry M (``F_Ac_W``) and a point pair's on the body of its
+    geometry B (``contact_force``)."""
+    forces = []
+    for i in range(contact_results.num_hydroelastic_contacts()):
+        info = contact_results.hydroelastic_contact_info(i)
+        m, n = info.contact_surface().id_M(), info.contact_surface().id_N()
+        f = np.asarray(info.F_Ac_W().translational(), float)
+        if m in on and n in by:
+            forces.append(f)
+        elif n in on and m in by:
+            forces.append(-f)
+    for i in range(contact_results.num_point_pair_contacts()):
+        info = contact_results.point_pair_contact_info(i)
+        a, b = info.point_pair().id_A, info.point_pair().id_B
+        f = np.asarray(info.contact_force(), float)
+        if b in on and a in by:
+            forces.append(f)
+        elif a in on and b in by:
+            forces.append(-f)
+    return forces
+
+
+def hand_contact(contact_results, *, wsg_q, geometries: HandGeometries, R_WG) -> HandContact:
+    """Which finger pads touch the object and how hard it pushes each outwards; `wsg_q` =
+    (q_left, q_right) [m], the first two entries of the station's ``wsg.state``; `R_WG`: the
+    orientation of the WSG's body in the world (a RotationMatrix or 3×3; its x axis is the
+    closing axis)."""
+    R = np.asarray(R_WG.matrix() if hasattr(R_WG, "matrix") else R_WG, float)
+    x_G = R[:, 0]
     obj = geometries.object
     surfaces = sum(1 for i in range(contact_results.num_hydroelastic_contacts())
                    if {contact_results.hydroelastic_contact_info(i).contact_surface().id_M(),
                        contact_results.hydroelastic_contact_info(i).contact_surface().id_N()}
                    & obj)
-    for a, b in contact_pairs(contact_results):
-        other = b if a in obj else a if b in obj else None
-        if other is None:
-            continue
-        touches_left |= other in geometries.left
-        touches_right |= other in geometries.right
-    return HandContact(float(wsg_q[1] - wsg_q[0]), touches_left, touches_right, surfaces)
+    left = forces_on(contact_results, on=geometries.left, by=obj)
+    right = forces_on(contact_results, on=geometries.right, by=obj)
+    return HandContact(float(wsg_q[1] - wsg_q[0]), bool(left), bool(right), surfaces,
+                       squeeze_left=float(-sum(f @ x_G for f in left)),
+                       squeeze_right=float(sum(f @ x_G for f in right)))
 
 
 def touches_table(contact_results, *, geometries: HandGeometries) -> bool:

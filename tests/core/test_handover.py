@@ -21,6 +21,7 @@ from tg_drake.planning.handover import (
     robot_gripper_points,
 )
 from tg_drake.robot import wrist_reach_margin
+from tg_drake.outcome import HandContact
 from tg_drake.tasks.judge import PASS_HEIGHT_TOLERANCE, judge_pass
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription
 
@@ -255,8 +256,13 @@ def test_the_logic_names_the_handle_of_a_tool_for_the_receiver():
 
 
 def judged(**changes):
-    args = dict(receiver_left=True, receiver_right=True, receiver_opening=0.02,
-                robot_touches=False, on_table=False, z_W=[0.3, 0.2995, 0.2992], held_for=1.0)
+    """judge_pass of a receiver squeezing the object with 40 N per pad, 20 mm apart, unless
+    `changes` say otherwise (the receiver's fields by their HandContact names)."""
+    receiver = dict(opening=0.02, left=True, right=True, hydroelastic=2, squeeze_left=40.0,
+                    squeeze_right=40.0)
+    receiver.update({k: changes.pop(k) for k in list(changes) if k in receiver})
+    args = dict(receiver=HandContact(**receiver), robot_touches=False, on_table=False,
+                z_W=[0.3, 0.2995, 0.2992], held_for=1.0)
     args.update(changes)
     return judge_pass(**args)
 
@@ -266,6 +272,8 @@ def test_judge_pass_success_is_the_receivers_steady_hold_alone():
     assert ok.task == "pass" and ok.success, ok
     assert ok.measure["height_change_m"] == pytest.approx(0.0008)
     assert ok.measure["receiver_held"] is True
+    # A thin blade squeezed by the compliant pads leaves the fingers at their closed limit: held.
+    assert judged(opening=0.0, squeeze_left=12.0, squeeze_right=12.0).success
     # The check's time is a sum of the plan's segment times: a hold of exactly the duration,
     # measured a rounding short of it, is the whole hold (a run measured 1 s − 2e-15 s).
     assert judged(held_for=1.0 - 2e-15).success
@@ -273,8 +281,10 @@ def test_judge_pass_success_is_the_receivers_steady_hold_alone():
 
 
 @pytest.mark.parametrize("change, words", [
-    (dict(receiver_right=False), "right pad not touching"),
-    (dict(receiver_opening=0.0005), "closed on air"),
+    (dict(right=False, squeeze_right=0.0), "right pad not touching"),
+    # Fingers at their closed limit, the object pressing on a pad's outside (pushing it inwards).
+    (dict(opening=0.0, squeeze_left=-5.0), "closed on air"),
+    (dict(squeeze_right=0.3), "does not push both pads apart"),
     (dict(robot_touches=True), "robot's pads"),
     (dict(on_table=True), "touches the table"),
     (dict(held_for=0.5), "only 0.50 s"),

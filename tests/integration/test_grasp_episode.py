@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tg_drake.grasping.dgi import FINGERTIP_Y, PAD_CENTER_Y
-from tg_drake.outcome import CLOSED_ON_AIR
+from tg_drake.outcome import CLOSED_ON_AIR, MIN_SQUEEZE
 from tg_drake.simulation.episode import EpisodeConfig, GraspWorld, run_grasp_batch, scripted_targets
 
 CYLINDER_SDF = """<?xml version="1.0"?>
@@ -60,15 +60,30 @@ def test_a_centred_grasp_holds_through_lift_and_shake(world):
     # 10 mm: the object may slip a little in the pads while it is lifted 0.1 m and shaken.
     assert result["object_rise"] == pytest.approx(0.1, abs=0.01)
     assert result["touches_left_pad"] and result["touches_right_pad"]
+    # Each pad pushed apart by about the grip force (the drive's 80 N effort limit).
+    assert min(result["squeeze"]) > 0.5 * EpisodeConfig().grip_force
     assert not result["touches_table"]
+
+
+def test_a_blade_thinner_than_the_pads_sink_is_held(tmp_path):
+    # A 1.5 mm × 6 cm × 10 cm blade standing on its edge: the compliant pads sink into it further
+    # than half its thickness, so the fingers close to their limit (0 mm apart) and squeeze it.
+    # Held by the one rule (it pushes both pads apart), lifted and shaken with the gripper.
+    path = tmp_path / "blade.sdf"
+    path.write_text(CYLINDER_SDF.replace("<cylinder><radius>0.033</radius><length>0.1</length>"
+                                         "</cylinder>", "<box><size>0.0015 0.06 0.1</size></box>"))
+    result = GraspWorld(str(path)).run(X_WO, top_down([0, 0, HEIGHT + 0.01]))
+    assert result["status"] == "ok" and result["success"], result
+    assert abs(result["finger_gap"]) <= CLOSED_ON_AIR
+    assert min(result["squeeze"]) >= MIN_SQUEEZE
+    assert result["object_rise"] == pytest.approx(0.1, abs=0.01)
 
 
 def test_a_grasp_beside_the_object_closes_on_nothing(world):
     result = world.run(X_WO, top_down([0.09, 0, HEIGHT + 0.01]))
     assert result["status"] == "ok" and not result["success"]
-    # Fully closed: pads that met on nothing end within the run's closed-on-air tolerance, the
-    # one rule of the label and the run's outcomes.
-    assert abs(result["finger_gap"]) <= CLOSED_ON_AIR
+    # Fully closed on nothing: no push on either pad.
+    assert abs(result["finger_gap"]) <= CLOSED_ON_AIR and result["squeeze"] == [0.0, 0.0]
     assert abs(result["object_rise"]) < 0.005  # the cylinder still stands on the table
     assert result["touches_table"] and not result["touches_left_pad"]
 

@@ -18,7 +18,7 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource
 
 import tg_drake.systems.supervisor as supervisor_module
-from tg_drake.outcome import HandGeometries
+from tg_drake.outcome import HandContact, HandGeometries
 from tg_drake.systems.grasp_planner import GraspPlanner
 from tg_drake.systems.plan_messages import PlanRequest, PlanState, PlanStatus
 from tg_drake.systems.supervisor import (
@@ -375,8 +375,8 @@ def test_a_regrasp_leg_then_perception_looks_again_and_the_final_leg_is_the_runs
     waits for the new latch, runs the gate, asks for the next leg (no regrasp allowed any more:
     max_regrasps 1) and judges the final leg's task; the outcome records the leg."""
     held = iter([True, True, False] * 2)  # closed, lifted, let go: leg 1, then the final leg
-    monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: SimpleNamespace(
-        held=next(held), opening=0.05, left=True, right=True))
+    monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: HandContact(
+        0.05, True, True, 2, *((40.0, 40.0) if next(held) else (0.0, 0.0))))
     monkeypatch.setattr(supervisor_module, "touches_table", lambda *a, **k: True)
     monkeypatch.setattr(supervisor_module, "placed", lambda *a, **k: (True, "placed 0.3 cm"))
     f = Fixed(task="p&pInUpright",
@@ -436,8 +436,8 @@ def test_with_retries_a_missed_grasp_is_looked_at_again_once_its_plan_is_over(mo
     """max_retries 1: plans end with the arm home (return_home); the missed grasp is recorded,
     perception asked to look only once the plan is over, then the next attempt is requested
     (return_home off: no retry left); a second miss ends the run, saying so."""
-    monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: SimpleNamespace(
-        held=False, opening=0.0, left=False, right=False))
+    monkeypatch.setattr(supervisor_module, "hand_contact",
+                        lambda contacts, **k: HandContact(0.0, False, False, 0))
     f = Fixed(config=SupervisorConfig(planning_start=0.0, period=0.01, planning_timeout=0.5,
                                       max_retries=1))
     look = f.supervisor.get_perception_status_input_port()

@@ -22,11 +22,11 @@ An episode (all times in seconds, `EpisodeConfig`):
 4. shake: a horizontal circle of radius `shake_amplitude` and a rotation about z_G (across the
    pads), `shake_cycles` times, under a sin² envelope so that it starts and stops at rest.
 
-Label: success when at the end the object is held between the fingers: the fingers closed onto
-something (their gap ended above `tg_drake.outcome.CLOSED_ON_AIR`, the run's rule for fingers that
-closed on air, and below the full opening less `min_finger_travel` on each side — fingers that
-never moved cannot hold anything, even if pressing their tips on a face carried the object up)
-and the object no longer touches the table. A run whose physics fails (solver error, NaN, the
+Label: success when at the end the object is held between the fingers — the run's one rule for
+"held", `tg_drake.outcome.is_held`: it pushes both pads apart — the fingers stand closer than the
+full opening less `min_finger_travel` on each side (fingers that never moved cannot hold anything,
+even if pressing their tips on a face carried the object up), and the object no longer touches the
+table. A run whose physics fails (solver error, NaN, the
 object falling through the table or flying off) is reported with status "sim_error" and its reason
 instead of a label.
 """
@@ -42,7 +42,6 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
 from pydrake.multibody.tree import (
-    BodyIndex,
     FixedOffsetFrame,
     PdControllerGains,
     PrismaticJoint,
@@ -55,8 +54,8 @@ from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem
 
 from tg_drake.errors import SimulationError
 from tg_drake.grasping.dgi import MAX_OPENING
-from tg_drake.outcome import CLOSED_ON_AIR
-from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS, WSG_FINGERS
+from tg_drake.outcome import HandGeometries, hand_contact, touches_table
+from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
 
 TABLE_TOP_Z = 0.0  # the table's top surface in the world [m] (table_top frame welded at W).
 FINGER_JOINTS = WSG_FINGER_JOINTS
@@ -245,12 +244,9 @@ class GraspWorld:
         self.wsg = wsg
         self.fingers = [plant.GetJointByName(n, wsg) for n in FINGER_JOINTS]
         self.carrier = [plant.GetJointByName(n, wsg) for n in CARRIER_JOINTS]
-        self._body_of = {g: body.index() for body in
-                         (plant.get_body(BodyIndex(i)) for i in range(plant.num_bodies()))
-                         for g in plant.GetCollisionGeometriesForBody(body)}
-        self._named_bodies = {"table": plant.GetBodyByName("table_top", table).index(),
-                              "left_pad": plant.GetBodyByName(WSG_FINGERS[0], wsg).index(),
-                              "right_pad": plant.GetBodyByName(WSG_FINGERS[1], wsg).index()}
+        self._hand = HandGeometries.from_plant(plant, object_body=self.object_body,
+                                               wsg_instance=wsg, table_instance=table)
+        self._gripper_body = plant.GetBodyByName(WSG_BODY, wsg)
         self.simulator = Simulator(self.diagram)
         self.context = self.simulator.get_mutable_context()
         self._default_state = self.context.get_discrete_state_vector().CopyToVector()
@@ -301,30 +297,23 @@ class GraspWorld:
             gap = self.fingers[1].get_translation(plant_context) \
                 - self.fingers[0].get_translation(plant_context)
             X_WO_end = self.plant.EvalBodyPoseInWorld(plant_context, self.object_body)
-            touching = self._object_contacts(plant_context)
-            closed_on_it = CLOSED_ON_AIR < gap < MAX_OPENING - 2 * c.min_finger_travel
+            contacts = self.plant.get_contact_results_output_port().Eval(plant_context)
+            hand = hand_contact(contacts, wsg_q=(self.fingers[0].get_translation(plant_context),
+                                                 self.fingers[1].get_translation(plant_context)),
+                                geometries=self._hand,
+                                R_WG=self._gripper_body.EvalPoseInWorld(plant_context).rotation())
+            on_table = touches_table(contacts, geometries=self._hand)
+            moved = gap < MAX_OPENING - 2 * c.min_finger_travel
             result.update(
-                success=bool(closed_on_it and not touching["table"]),
+                success=bool(hand.held and moved and not on_table),
                 finger_gap=float(gap),
+                squeeze=[hand.squeeze_left, hand.squeeze_right],
                 object_rise=float(X_WO_end.translation()[2] - z0),
-                touches_table=touching["table"],
-                touches_left_pad=touching["left_pad"],
-                touches_right_pad=touching["right_pad"])
+                touches_table=on_table,
+                touches_left_pad=hand.left,
+                touches_right_pad=hand.right)
         result["wall_time"] = time.perf_counter() - start
         return result
-
-    def _object_contacts(self, plant_context) -> dict[str, bool]:
-        """Whether the object touches the table and each pad (any contact model)."""
-        results = self.plant.get_contact_results_output_port().Eval(plant_context)
-        pairs = set()
-        for i in range(results.num_hydroelastic_contacts()):
-            surface = results.hydroelastic_contact_info(i).contact_surface()
-            pairs.add(frozenset((self._body_of[surface.id_M()], self._body_of[surface.id_N()])))
-        for i in range(results.num_point_pair_contacts()):
-            info = results.point_pair_contact_info(i)
-            pairs.add(frozenset((info.bodyA_index(), info.bodyB_index())))
-        obj = self.object_body.index()
-        return {name: frozenset((obj, body)) in pairs for name, body in self._named_bodies.items()}
 
     def _check(self, plant_context, z0: float) -> str | None:
         """Why the physics failed, or None."""

@@ -22,7 +22,7 @@ from tg_drake.bench import Figure
 from tg_drake.errors import PlanningError, SimulationError
 from tg_drake.grasping.pads import GRASP_DEPTH  # [m] the grasp point along +y_G
 from tg_drake.objects import get_object
-from tg_drake.outcome import CLOSED_ON_AIR
+from tg_drake.outcome import HandGeometries, hand_contact
 from tg_drake.planning.ik import make_arm_plant, solve_ik
 from tg_drake.robot import IIWA_HOME, WSG_BODY, WSG_MAX_OPENING
 from tg_drake.scenario import InverseDynamicsDriver, ObjectPlacement, Scenario
@@ -140,17 +140,15 @@ def grasp_and_lift(scenario: Scenario, *, object_name: str, p_W_grasp, lift: flo
     if not np.all(np.isfinite(X_WO.GetAsMatrix4())):
         raise SimulationError("the simulation diverged (non-finite object pose)")
     q_wsg = plant.GetPositions(plant_context, station.instances["wsg"])
-    opening = float(q_wsg[1] - q_wsg[0])
     contact: ContactResults = plant.get_contact_results_output_port().Eval(plant_context)
-    surfaces = 0
-    object_geometries = set(plant.GetCollisionGeometriesForBody(body))
-    for i in range(contact.num_hydroelastic_contacts()):
-        s = contact.hydroelastic_contact_info(i).contact_surface()
-        if s.id_M() in object_geometries or s.id_N() in object_geometries:
-            surfaces += 1
+    hand = hand_contact(contact, wsg_q=q_wsg[:2], R_WG=G.CalcPoseInWorld(plant_context).rotation(),
+                        geometries=HandGeometries.from_plant(
+                            plant, object_body=body, wsg_instance=station.instances["wsg"],
+                            table_instance=station.instances["table"]))
+    opening, surfaces = hand.opening, hand.hydroelastic
     object_rise = X_WO.translation()[2] - z_obj_grasp
     gripper_rise = G.CalcPoseInWorld(plant_context).translation()[2] - z_g_grasp
-    held = bool(object_rise > 0.8 * gripper_rise and opening > CLOSED_ON_AIR)
+    held = bool(object_rise > 0.8 * gripper_rise and hand.held)
     return GraspLiftResult(held, float(object_rise), float(gripper_rise), opening, surfaces,
                            times[-1], wall, render_time)
 

@@ -541,15 +541,15 @@ class Supervisor(LeafSystem):
         if t < key_time:
             return memory
         contacts = self._contacts_port.Eval(context)
-        hand = hand_contact(contacts, wsg_q=self._wsg_port.Eval(context)[:2],
-                            geometries=self._model.geometries)
         poses = self._poses_port.Eval(context)
+        hand = hand_contact(contacts, wsg_q=self._wsg_port.Eval(context)[:2],
+                            geometries=self._model.geometries,
+                            R_WG=poses[self._model.gripper_body].rotation())
         X_WO = poses[self._model.object_body]
         z_G = poses[self._model.gripper_body].translation()[2]
         if memory.checks_passed == 0:  # the gripper has closed
             if not hand.held:
-                why = (f"fingers closed to {hand.opening * 1000:.0f} mm without holding the "
-                       f"object (left pad {hand.left}, right pad {hand.right})")
+                why = f"fingers closed without holding the object ({hand.describe()})"
                 if memory.retries < self._config.max_retries:
                     return self._retry(context, memory, plan, X_WO, "missed")
                 return self._finish(memory, Status.failed, Reason.missed, why)
@@ -561,11 +561,9 @@ class Supervisor(LeafSystem):
             if not hand.held or rise < self._config.min_rise_ratio * gripper_rise:
                 if memory.retries < self._config.max_retries:
                     return self._retry(context, memory, plan, X_WO, "slipped")
-                # Say which test failed: the one rule of holding (outcome.is_held: both pads
-                # touch it, the fingers apart) or the rise it should have made with the gripper.
-                why = ("" if hand.held else
-                       f"not held at the lift's end (left pad {hand.left}, right pad "
-                       f"{hand.right}, fingers {hand.opening * 1000:.0f} mm apart); ")
+                # Say which test failed: the one rule of holding (outcome.is_held: it pushes
+                # both pads apart) or the rise it should have made with the gripper.
+                why = ("" if hand.held else f"not held at the lift's end ({hand.describe()}); ")
                 return self._finish(memory, Status.grasped, Reason.slipped,
                                     f"{why}the object rose {rise * 100:.1f} cm while the gripper "
                                     f"rose {gripper_rise * 100:.1f} cm")
@@ -705,11 +703,10 @@ class Supervisor(LeafSystem):
         if receiver is None or not self._receiver_port.HasValue(context):
             return TaskOutcome("pass", False, {}, "the station has no receiver")
         got = hand_contact(contacts, wsg_q=self._receiver_port.Eval(context)[:2],
-                           geometries=receiver)
+                           geometries=receiver,
+                           R_WG=self._poses_port.Eval(context)[receiver.gripper].rotation())
         z = memory.z_released + (float(X_WO.multiply(np.array(self._model.p_OC))[2]),)
-        return judge_pass(receiver_left=got.left, receiver_right=got.right,
-                          receiver_opening=got.opening,
-                          robot_touches=hand.left or hand.right,
+        return judge_pass(receiver=got, robot_touches=hand.left or hand.right,
                           on_table=touches_table(contacts, geometries=self._model.geometries),
                           z_W=np.array(z), held_for=context.get_time() - memory.t_released,
                           hold_duration=memory.status.plan.handover.hold_duration,

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tg_drake.outcome import PLACE_XY_TOLERANCE, is_held
+from tg_drake.outcome import CLOSED_ON_AIR, PLACE_XY_TOLERANCE, HandContact
 from tg_drake.perception.ground_truth import pose_from_transform
 from tg_drake.tasks.contents import ContentsModel, count_contents
 from tg_drake.tasks.outcome import TaskOutcome
@@ -108,28 +108,34 @@ PASS_HOLD_DURATION = 1.0  # [s] the receiver must hold it alone this long after 
 CLOCK_ROUNDING = 1e-9
 
 
-def judge_pass(*, receiver_left: bool, receiver_right: bool, receiver_opening: float,
-               robot_touches: bool, on_table: bool, z_W, held_for: float,
-               hold_duration: float = PASS_HOLD_DURATION,
+def judge_pass(*, receiver: HandContact, robot_touches: bool, on_table: bool, z_W,
+               held_for: float, hold_duration: float = PASS_HOLD_DURATION,
                tolerance: float = PASS_HEIGHT_TOLERANCE, receiver_part: str = "") -> TaskOutcome:
-    """pass: `held_for` [s] after the robot let go, the object touches both of the receiver's
-    pads (`receiver_left`, `receiver_right`; the receiver's fingers `receiver_opening` [m] apart,
-    more than closed on air: `tg_drake.outcome.is_held`), touches neither the robot's pads
-    (`robot_touches`) nor the table (`on_table`), and its height, sampled from the release to
-    now (`z_W` [m], world), stayed within `tolerance` [m]; `held_for` ≥ `hold_duration` [s].
-    `receiver_part`: the part the receiver took (reported)."""
+    """pass: `held_for` [s] after the robot let go, the receiver holds the object (`receiver`:
+    its pads' contact; the one rule for "held", `tg_drake.outcome.is_held`: the object pushes
+    both pads apart), it touches neither the robot's pads (`robot_touches`) nor the table
+    (`on_table`), and its height, sampled from the release to now (`z_W` [m], world), stayed
+    within `tolerance` [m]; `held_for` ≥ `hold_duration` [s]. `receiver_part`: the part the
+    receiver took (reported)."""
     z = np.asarray(z_W, float).ravel()
     drift = float(np.ptp(z)) if len(z) else float("inf")
-    held = is_held(receiver_left, receiver_right, receiver_opening)  # the one rule for "held"
-    measure = {"receiver_held": held, "receiver_pads": [bool(receiver_left), bool(receiver_right)],
-               "receiver_opening_m": round(float(receiver_opening), 4),
+    held = receiver.held  # the one rule for "held"
+    measure = {"receiver_held": held, "receiver_pads": [receiver.left, receiver.right],
+               "receiver_squeeze_n": [round(receiver.squeeze_left, 2),
+                                      round(receiver.squeeze_right, 2)],
+               "receiver_opening_m": round(float(receiver.opening), 4),
                "robot_touches": bool(robot_touches), "on_table": bool(on_table),
                "height_change_m": round(drift, 4) if np.isfinite(drift) else None,
                "held_for_s": round(float(held_for), 3), "receiver_part": receiver_part}
     if not held:
-        pads = [n for n, t in (("left", receiver_left), ("right", receiver_right)) if not t]
-        why = (f"its {' and '.join(pads)} pad{'s' if len(pads) > 1 else ''} not touching"
-               if pads else "its fingers closed on air")
+        pads = [n for n, t in (("left", receiver.left), ("right", receiver.right)) if not t]
+        if pads:
+            why = f"its {' and '.join(pads)} pad{'s' if len(pads) > 1 else ''} not touching"
+        elif receiver.opening <= CLOSED_ON_AIR:
+            why = (f"its fingers closed on air, the object pressing on their outsides or edges "
+                   f"({receiver.describe()})")
+        else:
+            why = f"the object does not push both pads apart ({receiver.describe()})"
         where = " (it lies on the table)" if on_table else ""
         return TaskOutcome("pass", False, measure, f"the receiver does not hold it: {why}{where}")
     if robot_touches:
