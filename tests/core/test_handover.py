@@ -10,6 +10,7 @@ import tg_drake.planning.handover as handover_module
 from tg_drake.errors import ScenarioError
 from tg_drake.grasping.feasibility import grip_width
 from tg_drake.logic.receive import receiver_parts
+from tg_drake.outcome import HandContact
 from tg_drake.planning.handover import (
     Handover,
     ReceiverConfig,
@@ -21,7 +22,6 @@ from tg_drake.planning.handover import (
     robot_gripper_points,
 )
 from tg_drake.robot import wrist_reach_margin
-from tg_drake.outcome import HandContact
 from tg_drake.tasks.judge import PASS_HEIGHT_TOLERANCE, judge_pass
 from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription
 

@@ -462,3 +462,27 @@ def test_with_retries_a_missed_grasp_is_looked_at_again_once_its_plan_is_over(mo
     o = f.outcome
     assert (o.status, o.reason, len(o.legs)) == ("failed", "missed", 1)
     assert o.detail.startswith("after 1 retried grasp(s) (max_retries = 1): fingers closed")
+
+
+def test_a_pass_whose_object_is_lost_during_the_carry_is_the_robots_slip(monkeypatch):
+    """pass: held at the grasp and at the lift's end, no longer held on arriving at the
+    hand-over pose: the run ends lifted, slipped, "lost during the carry" — not the receiver's
+    miss it would be judged as at the plan's end."""
+    held = iter([True, True, False])  # closed, lifted, arrived
+    monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: HandContact(
+        0.02, True, True, 2, *((40.0, 40.0) if next(held) else (0.0, 0.0))))
+    f = Fixed(task="pass")
+    f.advance(0.001)
+    motion = SimpleNamespace(t_arrive=0.3, part="handle", hold_duration=1.0)
+    plan = SimpleNamespace(regrasp=False, t_grasp_closed=0.1, t_lift_done=0.2, duration=0.8,
+                           t_pour=None, R_turn=None, X_WO_place=np.eye(4),
+                           t_handover=(0.5, 0.6), handover=motion)
+    f.plan(PlanStatus(PlanState.executing, attempt=1, part="usable_area", t_plan=0.01,
+                      plan=plan))
+    f.advance(0.25)
+    assert not f.outcome.final  # closed and lifted, held
+    f.advance(0.35)
+    o = f.outcome
+    assert (o.status, o.reason, o.final) == ("lifted", "slipped", True)
+    assert o.detail.startswith("lost during the carry: not held on arriving at the hand-over")
+    assert not o.task_outcome.success and "lost during the carry" in o.task_outcome.detail

@@ -213,7 +213,8 @@ class _Memory:
     failures: tuple = ()  # (part or None, reason) of every failed attempt, in order
     status: PlanStatus | None = None  # the planner's answer with the plan being executed
     checks_passed: int = 0  # execution checks passed: 1 grasp closed, 2 lift done, 3 the pour
-    # held over the bowl (pourOut plans only)
+    # held over the bowl (pour plans) or arrived at the hand-over still held (pass), 4 (pass)
+    # the robot let go
     z_G_grasped: float = 0.0  # [m] gripper body height when the grasp closed
     z_O_grasped: float = 0.0  # [m] object height when the grasp closed
     X_WO_picked: RigidTransform | None = None  # object pose when the plan started
@@ -531,7 +532,10 @@ class Supervisor(LeafSystem):
         t = context.get_time() - t_plan
         pour = () if plan.t_pour is None else (plan.t_pour[1],)
         t_handover = getattr(plan, "t_handover", None)  # plans without a hand-over may lack it
-        handover = () if t_handover is None else (t_handover[1],)
+        # pass: the robot has arrived at the hand-over pose (it must still hold the object),
+        # then it has let go
+        handover = () if t_handover is None else (
+            max(plan.handover.t_arrive, plan.t_lift_done), t_handover[1])
         key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, *handover, plan.duration)
         key_time = key_times[memory.checks_passed]
         if memory.t_released is not None and t < key_time:  # pass: the height while held
@@ -570,8 +574,14 @@ class Supervisor(LeafSystem):
             return dataclasses.replace(memory, checks_passed=2)
         if memory.checks_passed == 2 and pour:  # the pour's hold is over
             return dataclasses.replace(memory, checks_passed=3, held_at_pour=hand.held)
-        if memory.checks_passed == 2 and handover:  # pass: the robot has let go
-            return dataclasses.replace(memory, checks_passed=3, t_released=context.get_time(),
+        if memory.checks_passed == 2 and handover:  # pass: arrived at the hand-over pose
+            if not hand.held:
+                return self._finish(memory, Status.lifted, Reason.slipped,
+                                    f"lost during the carry: not held on arriving at the "
+                                    f"hand-over ({hand.describe()})")
+            return dataclasses.replace(memory, checks_passed=3)
+        if memory.checks_passed == 3 and handover:  # pass: the robot has let go
+            return dataclasses.replace(memory, checks_passed=4, t_released=context.get_time(),
                                        z_released=(float(X_WO.multiply(
                                            np.array(self._model.p_OC))[2]),))
         if handover:  # pass: the receiver has held it alone to the end of the plan
