@@ -122,3 +122,8 @@ def test_a_receiver_that_cannot_reach_fails_the_pass_saying_so():
     assert task["task"] == "pass" and not task["success"]
     assert "hand-over: the receiver cannot reach" in task["detail"], task
     assert "(reach 0.1 m)" in task["detail"]
+    # In a pass the hand-over depends on the robot's grasp alone: a part none of whose
+    # candidates can be handed over is told to the logic as unreachable, and the next one tried.
+    assert "middle" in result["outcome"]["unreachable_parts"]
+    assert result["outcome"]["requeries"] >= 1
+    assert "can be picked and handed over" in result["outcome"]["detail"]

@@ -35,7 +35,9 @@ grasp or lift pose, or the motions to and through them) or on the place side (pr
 retreat). The parts none of whose candidates can even be picked are `unreachable_parts`: what the
 logic receives as `collision(Part)` evidence (`tg_drake.systems.grasp_planner`). A part that can
 be picked but not placed is not a collision of that part: the place target is the problem, and
-the result says so.
+the result says so. A pass is the exception: the hand-over point is fixed, and whether the arm
+reaches it and the receiver finds a part free depends on the grasp alone, so there a part none of
+whose candidates can be picked and handed over is an unreachable part.
 
 Obstacles are the perceived objects' bounding boxes (`ObjectDescription.X_WO`, `extents`); the
 held object is its bounding box welded to the gripper.
@@ -424,10 +426,18 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
 
     elapsed = time.perf_counter() - t_start
     unreachable = tuple(p for p in parts_order if p in part_pickable and not part_pickable[p])
+    if plan is None and handover is not None and not budget_spent():
+        # A pass: where the object is handed over and whether the receiver finds a part free
+        # depend on the grasp alone (the hand-over point is fixed), so a part none of whose
+        # candidates both picks and hands over is blamed like one that cannot be picked.
+        unreachable = tuple(p for p in parts_order if p in part_pickable)
     if plan is None:
         examined = [r for r in reasons if r]
         first = examined[0] if examined else "none examined"
-        if unreachable:
+        if unreachable and handover is not None:
+            reason = (f"no candidate of {', '.join(unreachable)} can be picked and handed "
+                      "over; farthest: " + max(examined or [first], key=_stage))
+        elif unreachable:
             reason = (f"no candidate of {', '.join(unreachable)} can be picked; first failure: "
                       + first)
         else:
