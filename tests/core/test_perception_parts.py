@@ -185,6 +185,19 @@ def test_rim_pregrasps_on_a_wide_upright_top_only():
     assert rim_pregrasps(sideways, np.array([0.08, 0.08, 0.01]), cfg).shape == (0, 4, 4)
 
 
+def test_a_closed_top_gets_no_rim_grasps():
+    # A rim grasp puts a finger inside: where perception saw no inside (a lid), none is made.
+    from tg_drake.perception.pregrasp import part_pregrasps
+
+    X_WB = np.eye(4)
+    X_WB[:3, 3] = [0.7, 0.1, 0.06]
+    boxes = {"top": (X_WB, np.array([0.08, 0.08, 0.01]))}
+    X_open, _ = part_pregrasps(boxes, PART_LABELS.index)
+    X_closed, parts = part_pregrasps(boxes, PART_LABELS.index, open_top=False)
+    assert len(X_closed) == 12 and len(X_open) > 12  # the box faces only
+    assert set(parts.tolist()) == {PART_LABELS.index("top")}
+
+
 def test_a_long_part_also_gets_grasps_along_it_closing_across_it():
     from tg_drake.perception.config import PregraspConfig
     from tg_drake.perception.pregrasp import along_pregrasps

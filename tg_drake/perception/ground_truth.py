@@ -126,7 +126,8 @@ def describe_library_object(obj_id: str, X_WO: np.ndarray, X_WT: np.ndarray, *,
         boxes[PART_LABELS[label]] = PartBox(X_WO @ make_transform(R_OP, centre_O),
                                             0.5 * (b_hi - b_lo))
     X_WG, grasp_parts = part_pregrasps({k: (b.X_WB, b.half_extents) for k, b in boxes.items()},
-                                       part_index, pregrasp)
+                                       part_index, pregrasp,
+                                       open_top=not obj.is_tool and library_open_top(obj_id))
     return ObjectDescription(
         p_W=transform(X_WO, p_O), n_W=rotate(X_WO, n_O), labels=labels,
         visible=np.ones(len(p_O), bool), X_WO=X_WP, extents=hi - lo, pose=pose,

@@ -73,9 +73,10 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
     X_WO = X_WT @ make_transform(parts.R_TO, parts.p_TO)
     boxes = {name: PartBox(X_WT @ make_transform(parts.R_TO, centre), half)
              for name, (centre, half) in parts.boxes.items()}
-    X_WG, grasp_parts = part_pregrasps(
-        {name: (b.X_WB, b.half_extents) for name, b in boxes.items()}, part_index, cfg.pregrasp)
     seen = interior_seen(pose, parts.is_tool, cfg.pose)  # perception looked: 1 − seen is hidden
+    X_WG, grasp_parts = part_pregrasps(
+        {name: (b.X_WB, b.half_extents) for name, b in boxes.items()}, part_index, cfg.pregrasp,
+        open_top=seen > 0.0)
     return ObjectDescription(
         p_W=transform(X_WT, c.p_T), n_W=rotate(X_WT, c.n_T), labels=parts.labels,
         visible=c.visible, X_WO=X_WO, extents=parts.extents, pose=pose.pose,

@@ -112,19 +112,22 @@ def along_pregrasps(X_WB: np.ndarray, half_extents: np.ndarray,
 
 
 def part_pregrasps(boxes: dict[str, tuple[np.ndarray, np.ndarray]], part_index,
-                   cfg: PregraspConfig | None = None) -> tuple[np.ndarray, np.ndarray]:
+                   cfg: PregraspConfig | None = None, *, open_top: bool = True
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """Pre-grasps of every part box: ((M, 4, 4) X_WG, (M,) part labels).
 
     `boxes` maps a part name to (X_WB, half extents); `part_index` maps a name to its label. The
     twelve box-face pre-grasps per part come first, then the rim grasps of a wide upright top,
-    then the grasps along long parts (`along_pregrasps`), part by part.
+    then the grasps along long parts (`along_pregrasps`), part by part. A rim grasp puts a
+    finger inside the container: `open_top` False (perception saw no inside through the top,
+    `interior_seen` 0: a lid closes it) leaves the rim grasps out.
     """
     if not boxes:
         return np.zeros((0, 4, 4)), np.zeros(0, int)
     X = box_pregrasps(np.stack([b[0] for b in boxes.values()]),
                       np.stack([b[1] for b in boxes.values()]), cfg)
     labels = np.repeat([part_index(name) for name in boxes], 12)
-    if "top" in boxes:
+    if "top" in boxes and open_top:
         rim = rim_pregrasps(*boxes["top"], cfg)
         X = np.concatenate([X, rim])
         labels = np.concatenate([labels, np.full(len(rim), part_index("top"))])
