@@ -46,7 +46,7 @@ from pydrake.systems.framework import DiagramBuilder, EventStatus, LeafSystem
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.grasping.model import load_model
-from tg_drake.objects import box_centre, get_object
+from tg_drake.objects import box_centre, get_object, mesh
 from tg_drake.planning.task_motion import dispenser_obstacle, surfaces_in_world, task_placing
 from tg_drake.receiver import ReceiverDriver, handover_of
 from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario, place_surface
@@ -132,6 +132,13 @@ class Pipeline:
     task: LeafSystem
     config: PipelineConfig
     ports: dict = field(default_factory=dict)  # stage output ports by name
+
+
+def _part_vertices(object_id: str) -> tuple:
+    """(vertices (V, 3) [m], part labels (V,)) of a library object's mesh: where the supervisor
+    measures which part the receiver of a pass holds."""
+    V, _, L = mesh(object_id)
+    return np.asarray(V, float), np.asarray(L, int)
 
 
 def _contents_counter(scenario: Scenario, station: Station, target_placement):
@@ -284,7 +291,9 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
             p_OC=box_centre(target_placement.id), X_WT=X_WT.GetAsMatrix4(),
             is_tool=get_object(target_placement.id).is_tool,
             surfaces=[(s.name, surface_body_name(s.name)) for s in scenario.surfaces],
-            receiver_instance=station.instances.get("receiver")),
+            receiver_instance=station.instances.get("receiver"),
+            part_vertices=(_part_vertices(target_placement.id)
+                           if "receiver" in station.instances else None)),
         task=scenario.task.task, place_on=surface.name if surface is not None else "",
         pour_into=scenario.task.pour_into, container=target_placement.instance_name,
         count_contents=_contents_counter(scenario, station, target_placement),

@@ -125,6 +125,36 @@ def forces_on(contact_results, *, on: frozenset, by: frozenset) -> list[np.ndarr
     return forces
 
 
+def contact_points(contact_results, *, a: frozenset, b: frozenset) -> list[np.ndarray]:
+    """World points [m] where geometries `a` touch geometries `b`: each hydroelastic surface's
+    centroid, each point pair's contact point."""
+    points = []
+    for i in range(contact_results.num_hydroelastic_contacts()):
+        surface = contact_results.hydroelastic_contact_info(i).contact_surface()
+        if {surface.id_M(), surface.id_N()} & a and {surface.id_M(), surface.id_N()} & b:
+            points.append(np.asarray(surface.centroid(), float))
+    for i in range(contact_results.num_point_pair_contacts()):
+        info = contact_results.point_pair_contact_info(i)
+        ids = {info.point_pair().id_A, info.point_pair().id_B}
+        if ids & a and ids & b:
+            points.append(np.asarray(info.contact_point(), float))
+    return points
+
+
+def part_touched(points_W, X_WO, vertices_O, labels) -> int | None:
+    """The part label most of `points_W` lie nearest to: each point taken into the object's
+    frame (X_WO, 4×4) and given the label of the nearest of the object's labelled mesh vertices
+    (`vertices_O` (V, 3), `labels` (V,)); None without points or labels."""
+    if not len(points_W) or vertices_O is None or not len(vertices_O):
+        return None
+    X = np.asarray(X_WO, float)
+    p_O = (np.asarray(points_W, float) - X[:3, 3]) @ X[:3, :3]
+    V = np.asarray(vertices_O, float)
+    nearest = np.argmin(((p_O[:, None, :] - V[None, :, :]) ** 2).sum(axis=2), axis=1)
+    values, counts = np.unique(np.asarray(labels)[nearest], return_counts=True)
+    return int(values[np.argmax(counts)])
+
+
 def hand_contact(contact_results, *, wsg_q, geometries: HandGeometries, R_WG) -> HandContact:
     """Which finger pads touch the object and how hard it pushes each outwards; `wsg_q` =
     (q_left, q_right) [m], the first two entries of the station's ``wsg.state``; `R_WG`: the

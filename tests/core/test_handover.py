@@ -410,3 +410,28 @@ def test_the_receiver_keeps_clear_of_the_robots_arm():
         X_WG_robot=top_grasp(0.07, 0.3), receiver_parts={"handle": 0.9, "usable_area": 0.1},
         handover=HANDOVER, table_z=0.0, retreat=0.1, arm_p_W=link)
     assert grasp is not None and grasp.candidate == 1
+
+
+def test_the_part_touched_is_read_off_the_labelled_mesh_in_the_objects_frame():
+    from tg_drake.outcome import part_touched
+
+    # Two labelled vertices along the object's x: a handle at −0.1 m, a usable area at +0.1 m.
+    V = np.array([[-0.1, 0.0, 0.0], [0.1, 0.0, 0.0]])
+    handle, blade = PART_LABELS.index("handle"), PART_LABELS.index("usable_area")
+    labels = np.array([handle, blade])
+    X_WO = np.eye(4)
+    X_WO[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]  # 90° about z
+    X_WO[:3, 3] = [0.5, 0.0, 0.3]
+    # Pads touching at world (0.5, −0.09, 0.3) ± 1 cm: the object's x = −0.09 m, its handle.
+    points = [np.array([0.5, -0.09, 0.31]), np.array([0.5, -0.09, 0.29])]
+    assert part_touched(points, X_WO, V, labels) == handle
+    assert part_touched([np.array([0.5, 0.08, 0.3])], X_WO, V, labels) == blade
+    assert part_touched([], X_WO, V, labels) is None
+    assert part_touched(points, X_WO, None, None) is None
+
+
+def test_judge_pass_reports_the_part_the_receiver_holds():
+    ok = judged(received_part="handle")
+    assert ok.success and ok.measure["received_part"] == "handle"
+    assert "by its handle" in ok.detail
+    assert judged().measure["received_part"] == ""

@@ -136,3 +136,21 @@ def test_task_success_per_task_and_variant_beside_the_executed_e0():
     assert "| pourOut | Pipeline | 3 | **66.67** | 3 | 66.67 | 100.00 (1) | 50.00 (2) |" in md
     assert "Random part" in task_success_text(compute(records))
     assert compute([r for r in records if r["variant"] == "x"])["task_success"] == {}
+
+
+def test_the_part_the_receiver_holds_is_counted_over_successful_passes():
+    def passed(variant, part, success=True):
+        r = _record(variant, "train", success, grasp_part="usable_area", status="lifted",
+                    task="pass")
+        r["outcome"]["task_outcome"]["measure"] = {"received_part": part}
+        return r
+
+    records = [passed("pipeline", "handle"), passed("pipeline", "handle"),
+               passed("local", "usable_area"), passed("local", "handle", success=False),
+               passed("local", "")]
+    t = compute(records)["task_success"]["pass"]
+    assert t["pipeline"]["received"] == {"handle": 2}
+    assert t["local"]["received"] == {"usable_area": 1, "unknown": 1}  # the failure not counted
+    md = markdown(compute(records), command="tg-drake eval x")
+    assert "the part the receiver holds after a successful hand-over" in md
+    assert "Pipeline handle 2; Local usable_area 1, unknown 1." in md

@@ -73,6 +73,10 @@ def test_default_scenario_passes_the_cup_by_its_middle(cached_run):
     assert result["outcome"]["status"] == "lifted", result["outcome"]
     assert result["outcome"]["detail"].startswith("handed over"), result["outcome"]
     assert result["task_outcome"]["success"], result["task_outcome"]
+    # The part the receiver holds, measured on the cup's labelled mesh: one the robot left free.
+    m = result["task_outcome"]["measure"]
+    assert m["received_part"] in ("top", "bottom", "handle"), m
+    assert f"by its {m['received_part']}" in result["task_outcome"]["detail"]
     assert "cup" in summary(result) and "handed over" in summary(result)
     # P(hold) is reported beside the score, not as its factor, while the stage does not rank by it.
     assert not result["config"]["pipeline"]["feasibility"]["rank_by_hold"]

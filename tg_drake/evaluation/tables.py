@@ -441,6 +441,13 @@ def task_success(records) -> dict:
                         why = f"run failed: {o['reason']}"
                     failed[" ".join(str(why).split())[:60]] += 1
             row["failures"] = dict(sorted(failed.items(), key=lambda kv: -kv[1]))
+            if t == "pass":  # the part the receiver holds after a successful hand-over
+                received: dict = defaultdict(int)
+                for r in rs:
+                    if _task_success(r):
+                        m = ((r.get("outcome") or {}).get("task_outcome") or {}).get("measure")
+                        received[(m or {}).get("received_part") or "unknown"] += 1
+                row["received"] = dict(sorted(received.items(), key=lambda kv: -kv[1]))
             out.setdefault(t, {})[v] = row
         if t in out and "pipeline" in out[t] and "local" in out[t]:
             p, lo = out[t]["pipeline"]["success"], out[t]["local"]["success"]
@@ -684,6 +691,14 @@ def markdown(t: dict, *, command: str, notes: str = "") -> str:
                      f"{_f(sp['held_out']['success'])} ({sp['held_out']['n']}) | "
                      f"{_f(r['E0_executed'])} ({r['n_e0']}) | "
                      + "; ".join(f"{k} {n}" for k, n in r["failures"].items()) + " |")
+        received = {v: r["received"] for task_name, v, r in _task_rows(t["task_success"])
+                    if task_name == "pass" and r.get("received")}
+        if received:
+            L += ["", "pass, the part the receiver holds after a successful hand-over (measured "
+                  "on the object's labelled mesh at its pads' contact; the success test does not "
+                  "ask which): " + "; ".join(
+                      f"{LABELS[v]} " + ", ".join(f"{part} {n}" for part, n in parts.items())
+                      for v, parts in received.items()) + "."]
         diffs = {k: v.get("pipeline_minus_local") for k, v in t["task_success"].items()
                  if v.get("pipeline_minus_local") is not None}
         if diffs:

@@ -36,7 +36,7 @@ every decision that spans stages is taken here, in simulated time, from port val
 
 import dataclasses
 import enum
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -57,7 +57,9 @@ from tg_drake.grasping.feasibility import why_no_pose
 from tg_drake.outcome import (
     HandGeometries,
     contact_pairs,
+    contact_points,
     hand_contact,
+    part_touched,
     placed,
     touches_table,
 )
@@ -72,7 +74,13 @@ from tg_drake.tasks.judge import (
     rest_pose,
 )
 from tg_drake.tasks.outcome import TaskOutcome
-from tg_drake.types import GraspCandidates, GraspSemantics, PerceptionStatus, SceneDescription
+from tg_drake.types import (
+    PART_LABELS,
+    GraspCandidates,
+    GraspSemantics,
+    PerceptionStatus,
+    SceneDescription,
+)
 
 
 class Status(enum.StrEnum):
@@ -171,13 +179,18 @@ class MonitorModel:
     is_tool: bool = False
     surfaces: tuple = ()  # (name, frozenset of GeometryId) per surface
     receiver: HandGeometries | None = None  # pass: the target, the receiver's fingers, the table
+    # pass: the target's labelled mesh, (vertices (V, 3) in its frame [m], part labels (V,)): the
+    # part the receiver holds is measured on it (ground truth of the execution, like the poses)
+    part_vertices: tuple | None = field(default=None, compare=False)
 
     @classmethod
     def from_plant(cls, plant, *, object_body, wsg_instance, table_instance,
                    p_OC=(0.0, 0.0, 0.0), X_WT=None, is_tool: bool = False,
-                   surfaces=(), receiver_instance=None) -> "MonitorModel":
+                   surfaces=(), receiver_instance=None, part_vertices=None
+                   ) -> "MonitorModel":
         """`surfaces`: names of the surfaces' bodies in the table's model instance;
-        `receiver_instance`: a pass's receiver WSG (tg_drake.receiver), or None."""
+        `receiver_instance`: a pass's receiver WSG (tg_drake.receiver), or None;
+        `part_vertices`: (vertices, labels) of the target's mesh, or None."""
         surface_ids = tuple(
             (name, frozenset(plant.GetCollisionGeometriesForBody(
                 plant.GetBodyByName(body, table_instance)))) for name, body in surfaces)
@@ -190,7 +203,7 @@ class MonitorModel:
                    bool(is_tool), surface_ids,
                    None if receiver_instance is None else HandGeometries.from_plant(
                        plant, object_body=object_body, wsg_instance=receiver_instance,
-                       table_instance=table_instance))
+                       table_instance=table_instance), part_vertices)
 
 
 class Phase(enum.StrEnum):
@@ -716,7 +729,11 @@ class Supervisor(LeafSystem):
                            geometries=receiver,
                            R_WG=self._poses_port.Eval(context)[receiver.gripper].rotation())
         z = memory.z_released + (float(X_WO.multiply(np.array(self._model.p_OC))[2]),)
+        received = part_touched(
+            contact_points(contacts, a=receiver.left | receiver.right, b=receiver.object),
+            X_WO.GetAsMatrix4(), *(self._model.part_vertices or (None, None)))
         return judge_pass(receiver=got, robot_touches=hand.left or hand.right,
+                          received_part="" if received is None else PART_LABELS[received],
                           on_table=touches_table(contacts, geometries=self._model.geometries),
                           z_W=np.array(z), held_for=context.get_time() - memory.t_released,
                           hold_duration=memory.status.plan.handover.hold_duration,

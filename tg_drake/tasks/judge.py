@@ -110,13 +110,15 @@ CLOCK_ROUNDING = 1e-9
 
 def judge_pass(*, receiver: HandContact, robot_touches: bool, on_table: bool, z_W,
                held_for: float, hold_duration: float = PASS_HOLD_DURATION,
-               tolerance: float = PASS_HEIGHT_TOLERANCE, receiver_part: str = "") -> TaskOutcome:
+               tolerance: float = PASS_HEIGHT_TOLERANCE, receiver_part: str = "",
+               received_part: str = "") -> TaskOutcome:
     """pass: `held_for` [s] after the robot let go, the receiver holds the object (`receiver`:
     its pads' contact; the one rule for "held", `tg_drake.outcome.is_held`: the object pushes
     both pads apart), it touches neither the robot's pads (`robot_touches`) nor the table
     (`on_table`), and its height, sampled from the release to now (`z_W` [m], world), stayed
     within `tolerance` [m]; `held_for` ≥ `hold_duration` [s]. `receiver_part`: the part the
-    receiver took (reported)."""
+    receiver was planned to take, and `received_part` the part its pads touch at the end
+    (measured on the object's labelled mesh; "" when unknown): both reported, neither judged."""
     z = np.asarray(z_W, float).ravel()
     drift = float(np.ptp(z)) if len(z) else float("inf")
     held = receiver.held  # the one rule for "held"
@@ -126,7 +128,8 @@ def judge_pass(*, receiver: HandContact, robot_touches: bool, on_table: bool, z_
                "receiver_opening_m": round(float(receiver.opening), 4),
                "robot_touches": bool(robot_touches), "on_table": bool(on_table),
                "height_change_m": round(drift, 4) if np.isfinite(drift) else None,
-               "held_for_s": round(float(held_for), 3), "receiver_part": receiver_part}
+               "held_for_s": round(float(held_for), 3), "receiver_part": receiver_part,
+               "received_part": received_part}
     if not held:
         pads = [n for n, t in (("left", receiver.left), ("right", receiver.right)) if not t]
         if pads:
@@ -149,6 +152,7 @@ def judge_pass(*, receiver: HandContact, robot_touches: bool, on_table: bool, z_
         return TaskOutcome("pass", False, measure,
                            f"its height changed {drift * 1000:.0f} mm while the receiver held "
                            f"it (> {tolerance * 1000:.0f} mm): it slipped")
+    by = f" by its {received_part.replace('_', ' ')}" if received_part else ""
     return TaskOutcome("pass", True, measure,
-                       f"the receiver held it alone {held_for:.1f} s, its height steady within "
-                       f"{drift * 1000:.1f} mm")
+                       f"the receiver held it alone{by} {held_for:.1f} s, its height steady "
+                       f"within {drift * 1000:.1f} mm")
