@@ -80,9 +80,10 @@ def episode_config(text: str | None) -> EpisodeConfig:
 
 
 def held_failures(records: list[dict], episode: EpisodeConfig) -> dict:
-    """Recorded failures whose object nevertheless ended between both pads and off the table:
-    the label's finger-gap rule (`tg_drake.outcome.CLOSED_ON_AIR`,
-    `EpisodeConfig.min_finger_travel`) called them failures."""
+    """Recorded failures whose object nevertheless ended between both pads and off the table,
+    sorted by the fingers' gap: at their closed limit (`tg_drake.outcome.CLOSED_ON_AIR`; the
+    label of episodes recorded before the pads' push decided "held", 31fd7cd, called those
+    failures) or open past `EpisodeConfig.min_finger_travel` (fingers that never moved)."""
     from tg_drake.grasping.dgi import MAX_OPENING
     from tg_drake.outcome import CLOSED_ON_AIR
 
