@@ -50,7 +50,7 @@ class HandGeometries:
     left: frozenset
     right: frozenset
     table: frozenset
-    gripper: int = -1
+    gripper: int  # the WSG body's index (in ``body_poses``)
 
     @classmethod
     def from_plant(cls, plant, *, object_body, wsg_instance, table_instance) -> HandGeometries:
@@ -87,58 +87,54 @@ class HandContact:
                 f"{MIN_SQUEEZE:.0f} N each), fingers {self.opening * 1000:.1f} mm apart")
 
 
+@dataclass(frozen=True)
+class Contact:
+    """One hydroelastic surface or point pair of the plant's ``contact_results``: its two
+    geometries, the contact force on `a`'s body [N] and a point of it [m] (world frame), and
+    whether it is a hydroelastic surface."""
+
+    a: object  # GeometryId
+    b: object  # GeometryId
+    f_a: np.ndarray
+    p: np.ndarray
+    hydroelastic: bool
+
+
+def contacts_of(contact_results) -> list[Contact]:
+    """Every contact in `contact_results`. Drake gives a hydroelastic surface's force on the body
+    of its geometry M (``F_Ac_W``, at the surface's centroid) and a point pair's on the body of
+    its geometry B (``contact_force``, at ``contact_point``): `a` is M, or A."""
+    out = []
+    for i in range(contact_results.num_hydroelastic_contacts()):
+        info = contact_results.hydroelastic_contact_info(i)
+        s = info.contact_surface()
+        out.append(Contact(s.id_M(), s.id_N(), np.asarray(info.F_Ac_W().translational(), float),
+                           np.asarray(s.centroid(), float), True))
+    for i in range(contact_results.num_point_pair_contacts()):
+        info = contact_results.point_pair_contact_info(i)
+        pair = info.point_pair()
+        out.append(Contact(pair.id_A, pair.id_B, -np.asarray(info.contact_force(), float),
+                           np.asarray(info.contact_point(), float), False))
+    return out
+
+
 def contact_pairs(contact_results) -> list[tuple]:
     """(GeometryId, GeometryId) of every hydroelastic surface and point pair in `contact_results`
     (the plant's ``contact_results`` output)."""
-    pairs = []
-    for i in range(contact_results.num_hydroelastic_contacts()):
-        s = contact_results.hydroelastic_contact_info(i).contact_surface()
-        pairs.append((s.id_M(), s.id_N()))
-    for i in range(contact_results.num_point_pair_contacts()):
-        info = contact_results.point_pair_contact_info(i).point_pair()
-        pairs.append((info.id_A, info.id_B))
-    return pairs
+    return [(c.a, c.b) for c in contacts_of(contact_results)]
 
 
-def forces_on(contact_results, *, on: frozenset, by: frozenset) -> list[np.ndarray]:
+def forces_on(contacts: list[Contact], *, on: frozenset, by: frozenset) -> list[np.ndarray]:
     """The contact forces [N] (world frame) on the geometries `on` from the geometries `by`, one
-    per hydroelastic surface or point pair between them. Drake gives a hydroelastic surface's
-    force on the body of its geometry M (``F_Ac_W``) and a point pair's on the body of its
-    geometry B (``contact_force``)."""
-    forces = []
-    for i in range(contact_results.num_hydroelastic_contacts()):
-        info = contact_results.hydroelastic_contact_info(i)
-        m, n = info.contact_surface().id_M(), info.contact_surface().id_N()
-        f = np.asarray(info.F_Ac_W().translational(), float)
-        if m in on and n in by:
-            forces.append(f)
-        elif n in on and m in by:
-            forces.append(-f)
-    for i in range(contact_results.num_point_pair_contacts()):
-        info = contact_results.point_pair_contact_info(i)
-        a, b = info.point_pair().id_A, info.point_pair().id_B
-        f = np.asarray(info.contact_force(), float)
-        if b in on and a in by:
-            forces.append(f)
-        elif a in on and b in by:
-            forces.append(-f)
-    return forces
+    per contact between them (`contacts`: `contacts_of`)."""
+    return ([c.f_a for c in contacts if c.a in on and c.b in by]
+            + [-c.f_a for c in contacts if c.b in on and c.a in by])
 
 
-def contact_points(contact_results, *, a: frozenset, b: frozenset) -> list[np.ndarray]:
-    """World points [m] where geometries `a` touch geometries `b`: each hydroelastic surface's
-    centroid, each point pair's contact point."""
-    points = []
-    for i in range(contact_results.num_hydroelastic_contacts()):
-        surface = contact_results.hydroelastic_contact_info(i).contact_surface()
-        if {surface.id_M(), surface.id_N()} & a and {surface.id_M(), surface.id_N()} & b:
-            points.append(np.asarray(surface.centroid(), float))
-    for i in range(contact_results.num_point_pair_contacts()):
-        info = contact_results.point_pair_contact_info(i)
-        ids = {info.point_pair().id_A, info.point_pair().id_B}
-        if ids & a and ids & b:
-            points.append(np.asarray(info.contact_point(), float))
-    return points
+def contact_points(contacts: list[Contact], *, a: frozenset, b: frozenset) -> list[np.ndarray]:
+    """World points [m] where geometries `a` touch geometries `b` (`contacts`: `contacts_of`):
+    each hydroelastic surface's centroid, each point pair's contact point."""
+    return [c.p for c in contacts if {c.a, c.b} & a and {c.a, c.b} & b]
 
 
 def part_touched(points_W, X_WO, vertices_O, labels) -> int | None:
@@ -158,18 +154,15 @@ def part_touched(points_W, X_WO, vertices_O, labels) -> int | None:
 def hand_contact(contact_results, *, wsg_q, geometries: HandGeometries, R_WG) -> HandContact:
     """Which finger pads touch the object and how hard it pushes each outwards; `wsg_q` =
     (q_left, q_right) [m], the first two entries of the station's ``wsg.state``; `R_WG`: the
-    orientation of the WSG's body in the world (a RotationMatrix or 3×3; its x axis is the
-    closing axis)."""
-    R = np.asarray(R_WG.matrix() if hasattr(R_WG, "matrix") else R_WG, float)
-    x_G = R[:, 0]
+    orientation of the WSG's body in the world (a RotationMatrix; its x axis is the closing
+    axis)."""
+    x_G = np.asarray(R_WG.col(0), float).ravel()
     obj = geometries.object
-    surfaces = sum(1 for i in range(contact_results.num_hydroelastic_contacts())
-                   if {contact_results.hydroelastic_contact_info(i).contact_surface().id_M(),
-                       contact_results.hydroelastic_contact_info(i).contact_surface().id_N()}
-                   & obj)
-    left = forces_on(contact_results, on=geometries.left, by=obj)
-    right = forces_on(contact_results, on=geometries.right, by=obj)
-    return HandContact(float(wsg_q[1] - wsg_q[0]), bool(left), bool(right), surfaces,
+    contacts = contacts_of(contact_results)
+    left = forces_on(contacts, on=geometries.left, by=obj)
+    right = forces_on(contacts, on=geometries.right, by=obj)
+    return HandContact(float(wsg_q[1] - wsg_q[0]), bool(left), bool(right),
+                       sum(1 for c in contacts if c.hydroelastic and {c.a, c.b} & obj),
                        squeeze_left=float(-sum(f @ x_G for f in left)),
                        squeeze_right=float(sum(f @ x_G for f in right)))
 

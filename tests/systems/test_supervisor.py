@@ -40,8 +40,8 @@ from tg_drake.types import (
 )
 
 # No plant: the gate and the re-query policy never read the monitor's geometry.
-NO_MODEL = MonitorModel(HandGeometries(frozenset(), frozenset(), frozenset(), frozenset()),
-                        object_body=0, gripper_body=0)
+NO_MODEL = MonitorModel(HandGeometries(frozenset(), frozenset(), frozenset(), frozenset(),
+                                       gripper=0), object_body=0)
 CONFIG = SupervisorConfig(planning_start=0.0, period=0.01, planning_timeout=0.5)
 Q_MEASURED = np.array([0.1, -0.5, 0.05, -1.8, 0.0, 1.1, 0.2])  # a posture near IIWA_HOME
 

@@ -294,19 +294,17 @@ class GraspWorld:
         except RuntimeError as e:
             result = {"status": "sim_error", "reason": f"{type(e).__name__}: {e}".strip()[:300]}
         if result["status"] == "ok":
-            gap = self.fingers[1].get_translation(plant_context) \
-                - self.fingers[0].get_translation(plant_context)
             X_WO_end = self.plant.EvalBodyPoseInWorld(plant_context, self.object_body)
             contacts = self.plant.get_contact_results_output_port().Eval(plant_context)
-            hand = hand_contact(contacts, wsg_q=(self.fingers[0].get_translation(plant_context),
-                                                 self.fingers[1].get_translation(plant_context)),
+            hand = hand_contact(contacts, wsg_q=[f.get_translation(plant_context)
+                                                 for f in self.fingers],
                                 geometries=self._hand,
                                 R_WG=self._gripper_body.EvalPoseInWorld(plant_context).rotation())
             on_table = touches_table(contacts, geometries=self._hand)
-            moved = gap < MAX_OPENING - 2 * c.min_finger_travel
+            moved = hand.opening < MAX_OPENING - 2 * c.min_finger_travel
             result.update(
                 success=bool(hand.held and moved and not on_table),
-                finger_gap=float(gap),
+                finger_gap=hand.opening,
                 squeeze=[hand.squeeze_left, hand.squeeze_right],
                 object_rise=float(X_WO_end.translation()[2] - z0),
                 touches_table=on_table,

@@ -58,6 +58,7 @@ from tg_drake.outcome import (
     HandGeometries,
     contact_pairs,
     contact_points,
+    contacts_of,
     hand_contact,
     part_touched,
     placed,
@@ -166,14 +167,13 @@ def outcome_of_error(error: Exception, *, pending: Outcome | None = None) -> Out
 @dataclass(frozen=True)
 class MonitorModel:
     """What the execution monitor needs to know about the plant's model (read once, before
-    simulating): the geometry ids of the target, fingers and table, the indices of the target's
-    and the gripper's bodies in ``body_poses``, and the target's box centre in its frame [m];
+    simulating): the geometry ids of the target, fingers and table and the gripper's body index
+    (`geometries`), the target's body index in ``body_poses`` and its box centre in its frame [m];
     for the task check: the table frame, whether the target is a tool, and the collision
     geometry ids of each of the scenario's surfaces (by name; they belong to the table)."""
 
-    geometries: HandGeometries
+    geometries: HandGeometries  # its `gripper`: the WSG body's index in ``body_poses``
     object_body: int
-    gripper_body: int
     p_OC: tuple = (0.0, 0.0, 0.0)
     X_WT: tuple = tuple(map(tuple, np.eye(4)))  # 4×4 table frame, as nested tuples
     is_tool: bool = False
@@ -197,7 +197,7 @@ class MonitorModel:
         return cls(HandGeometries.from_plant(plant, object_body=object_body,
                                              wsg_instance=wsg_instance,
                                              table_instance=table_instance),
-                   int(object_body.index()), int(plant.GetBodyByName("body", wsg_instance).index()),
+                   int(object_body.index()),
                    tuple(float(v) for v in p_OC),
                    tuple(map(tuple, np.eye(4) if X_WT is None else np.asarray(X_WT, float))),
                    bool(is_tool), surface_ids,
@@ -561,9 +561,9 @@ class Supervisor(LeafSystem):
         poses = self._poses_port.Eval(context)
         hand = hand_contact(contacts, wsg_q=self._wsg_port.Eval(context)[:2],
                             geometries=self._model.geometries,
-                            R_WG=poses[self._model.gripper_body].rotation())
+                            R_WG=poses[self._model.geometries.gripper].rotation())
         X_WO = poses[self._model.object_body]
-        z_G = poses[self._model.gripper_body].translation()[2]
+        z_G = poses[self._model.geometries.gripper].translation()[2]
         if memory.checks_passed == 0:  # the gripper has closed
             if not hand.held:
                 why = f"fingers closed without holding the object ({hand.describe()})"
@@ -598,7 +598,7 @@ class Supervisor(LeafSystem):
                                        z_released=(float(X_WO.multiply(
                                            np.array(self._model.p_OC))[2]),))
         if handover:  # pass: the receiver has held it alone to the end of the plan
-            task = self._judge_pass(context, memory, contacts, hand, X_WO)
+            task = self._judge_pass(context, memory, contacts, hand, poses)
             detail = ("handed over: " if task.success else "let go at the hand-over; ") \
                 + task.detail
             return self._finish(memory, Status.lifted, Reason.none, detail, task)
@@ -720,17 +720,19 @@ class Supervisor(LeafSystem):
         return TaskOutcome(task, False, {}, f"the {task} motion and check are not implemented "
                            "yet: the object was placed as for pick-and-place")
 
-    def _judge_pass(self, context, memory: _Memory, contacts, hand, X_WO) -> TaskOutcome:
+    def _judge_pass(self, context, memory: _Memory, contacts, hand, poses) -> TaskOutcome:
         """pass at the end of the plan: the receiver's hold since the robot's release."""
         receiver = self._model.receiver
         if receiver is None or not self._receiver_port.HasValue(context):
             return TaskOutcome("pass", False, {}, "the station has no receiver")
         got = hand_contact(contacts, wsg_q=self._receiver_port.Eval(context)[:2],
                            geometries=receiver,
-                           R_WG=self._poses_port.Eval(context)[receiver.gripper].rotation())
+                           R_WG=poses[receiver.gripper].rotation())
+        X_WO = poses[self._model.object_body]
         z = memory.z_released + (float(X_WO.multiply(np.array(self._model.p_OC))[2]),)
         received = part_touched(
-            contact_points(contacts, a=receiver.left | receiver.right, b=receiver.object),
+            contact_points(contacts_of(contacts), a=receiver.left | receiver.right,
+                           b=receiver.object),
             X_WO.GetAsMatrix4(), *(self._model.part_vertices or (None, None)))
         return judge_pass(receiver=got, robot_touches=hand.left or hand.right,
                           received_part="" if received is None else PART_LABELS[received],
