@@ -29,7 +29,7 @@ MIN_SQUEEZE = 1.0
 # in reasons, not used for "held" (pads that close on nothing stop at 0, each finger's limit).
 CLOSED_ON_AIR = 0.001
 # Placement tolerances: distance of the object's centre from the place target on the table [m],
-# tilt of its axis from the pose it was picked in [rad].
+# change of its axis' angle to the table from the pose it was picked in [rad].
 PLACE_XY_TOLERANCE = 0.05
 PLACE_TILT_TOLERANCE = np.deg2rad(20)
 
@@ -174,24 +174,31 @@ def touches_table(contact_results, *, geometries: HandGeometries) -> bool:
                for a, b in contact_pairs(contact_results))
 
 
+def axis_elevation(X_WO) -> float:
+    """The angle of the object's axis z_O above the table plane [rad]: π/2 upright, 0 lying,
+    −π/2 upside down, whichever way it faces about the vertical."""
+    return float(np.arcsin(np.clip(X_WO.rotation().col(2)[2], -1.0, 1.0)))
+
+
 def placed(X_WO_picked, X_WO_now, p_W_target_xy, *, released: bool,
            p_OC=(0.0, 0.0, 0.0)) -> tuple[bool, str]:
-    """Is the object standing at the place target, in the pose it was picked in, and let go
+    """Is the object resting at the place target, in the pose it was picked in, and let go
     (resting on the table with the gripper open)?
 
     The place target is where the planner puts the centre of the object's box (what perception
     sees), so the distance is measured from the true box centre `p_OC` (in the object frame O; a
     library object's frame origin sits at its base, half a length away from the centre when it
-    lies on its side)."""
+    lies on its side). The pose is the axis' angle to the table (`axis_elevation`): tipping
+    changes it, a turn about the vertical does not — the planner may turn the object about the
+    vertical to place it (`PlannerConfig.place_yaws`), and a lying object turned so still lies."""
     p_WC = X_WO_now.multiply(np.asarray(p_OC, float))
     xy_error = float(np.linalg.norm(p_WC[:2] - np.asarray(p_W_target_xy)))
-    z_before = X_WO_picked.rotation().col(2)
-    z_now = X_WO_now.rotation().col(2)
-    tilt = float(np.arccos(np.clip(np.dot(z_before, z_now), -1.0, 1.0)))
+    tilt = abs(axis_elevation(X_WO_now) - axis_elevation(X_WO_picked))
     if not released:
         return False, "not let go: still held, or not resting on the table"
     if xy_error > PLACE_XY_TOLERANCE:
         return False, f"{xy_error * 100:.1f} cm from the place target"
     if tilt > PLACE_TILT_TOLERANCE:
-        return False, f"tipped over ({np.rad2deg(tilt):.0f}° from its picked pose)"
+        return False, (f"tipped over (its axis {np.rad2deg(tilt):.0f}° off its picked pose's "
+                       "angle to the table)")
     return True, f"{xy_error * 100:.1f} cm from the target, tilted {np.rad2deg(tilt):.0f}°"

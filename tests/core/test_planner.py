@@ -18,6 +18,7 @@ from tg_drake.planning.ik import (
 )
 from tg_drake.planning.planner import (
     PlannerConfig,
+    carried_box,
     place_pose,
     plan_pick_and_place,
 )
@@ -206,6 +207,50 @@ def test_place_pose_keeps_orientation_and_lifts_the_box_off_the_table():
     # Turned about x, the box's 0.2 m side (its y axis) is vertical: its centre goes 0.1 m up,
     # plus the release height.
     np.testing.assert_allclose(X[:3, 3], [0.6, -0.3, 0.1 + 0.01], atol=1e-12)
+
+
+def lying_cylinder(slant_deg: float):
+    """A cylinder (r 4 cm, 12 cm long) lying on the table along world y, its surface points, and
+    a perceived frame O on its axis turned `slant_deg` about it (as perception's box follows a
+    mug's handle pointing up at a slant), with the box of the points along O's axes."""
+    rng = np.random.default_rng(0)
+    theta, s = rng.uniform(0, 2 * np.pi, 2000), rng.uniform(-0.06, 0.06, 2000)
+    centre = np.array([0.7, 0.1, 0.04])
+    p_W = centre + np.column_stack([0.04 * np.cos(theta), s, 0.04 * np.sin(theta)])
+    a = np.deg2rad(slant_deg)
+    # z_O along the axis (world y), x_O turned by the slant about it
+    R = np.column_stack([[np.cos(a), 0.0, np.sin(a)], [-np.sin(a), 0.0, np.cos(a)], [0, 1.0, 0]])
+    R[:, 1] = np.cross(R[:, 2], R[:, 0])
+    obj = box_object(centre, [0.08, 0.08, 0.12])
+    obj.X_WO = np.eye(4)
+    obj.X_WO[:3, :3], obj.X_WO[:3, 3] = R, centre
+    q = (p_W - centre) @ R
+    obj.extents = q.max(axis=0) - q.min(axis=0)
+    obj.p_W = p_W
+    return obj
+
+
+@pytest.mark.parametrize("slant_deg", [0.0, 35.0])
+def test_the_carried_box_sets_a_lying_object_down_where_its_points_rest(slant_deg):
+    obj = lying_cylinder(slant_deg)
+    held = carried_box(obj)
+    X = place_pose(obj.X_WO, held.size, (0.6, -0.3), release_height=0.01, X_OB=held.X_OB)
+    np.testing.assert_allclose(X[:3, :3], obj.X_WO[:3, :3], atol=1e-15)
+    # the object is set down with its lowest point 1 cm up: its axis at 4 cm + 1 cm
+    assert X[2, 3] == pytest.approx(0.05, abs=2e-4)
+    # the box's bottom is level: the carried box has a vertical side
+    R_WB = obj.X_WO[:3, :3] @ held.X_OB[:3, :3]
+    np.testing.assert_allclose(np.abs(R_WB[:, 2]), [0.0, 0.0, 1.0], atol=1e-9)
+    # the perceived box, turned with O, puts a corner 4 cm·(cos + sin − 1) lower
+    X_box = place_pose(obj.X_WO, obj.extents, (0.6, -0.3), release_height=0.01)
+    a = np.deg2rad(slant_deg)
+    assert X_box[2, 3] - X[2, 3] == pytest.approx(0.04 * (np.cos(a) + np.sin(a) - 1), abs=5e-4)
+
+
+def test_without_points_the_carried_box_is_the_perceived_box():
+    held = carried_box(BOX)
+    np.testing.assert_array_equal(held.X_OB, np.eye(4))
+    assert held.size == tuple(BOX.extents)
 
 
 # A full plan with a second object next to the target, reused by the trajectory checks.

@@ -486,3 +486,24 @@ def test_a_pass_whose_object_is_lost_during_the_carry_is_the_robots_slip(monkeyp
     assert (o.status, o.reason, o.final) == ("lifted", "slipped", True)
     assert o.detail.startswith("lost during the carry: not held on arriving at the hand-over")
     assert not o.task_outcome.success and "lost during the carry" in o.task_outcome.detail
+
+
+@pytest.mark.parametrize("t_pour", [None, (0.25, 0.3)])
+def test_a_place_whose_object_is_lost_during_the_carry_says_so(monkeypatch, t_pour):
+    """A place: held at the grasp, at the lift's end (and at the pour's end), no longer held as
+    the descent to the place begins: lifted, slipped, "lost during the carry" — not the distance
+    from the place target where the dropped object happened to land."""
+    held = iter([True, True] + ([True] if t_pour else []) + [False])
+    monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: HandContact(
+        0.02, True, True, 2, *((40.0, 40.0) if next(held) else (0.0, 0.0))))
+    f = Fixed(task="p&pOn")
+    f.advance(0.001)
+    plan = SimpleNamespace(regrasp=False, t_grasp_closed=0.1, t_lift_done=0.2, duration=0.8,
+                           t_pour=t_pour, R_turn=None, X_WO_place=np.eye(4), t_descend=0.4)
+    f.plan(PlanStatus(PlanState.executing, attempt=1, part="middle", t_plan=0.01, plan=plan))
+    f.advance(0.35)
+    assert not f.outcome.final  # closed, lifted (and poured), held
+    f.advance(0.45)
+    o = f.outcome
+    assert (o.status, o.reason, o.final) == ("lifted", "slipped", True)
+    assert o.detail.startswith("lost during the carry: not held as the descent to the place")

@@ -22,7 +22,8 @@ inverse-kinematics solutions, inside the joint limits and clear of collisions, f
 
 where X_WO_place is the object's pose X_WO moved to the place target's xy, its orientation kept
 (or turned about the vertical by one of `place_yaws` when the kept one cannot be placed), and
-raised so that its box's lowest corner is `release_height` above the table. The IK is local,
+raised so that the lowest corner of the box it carries (`carried_box`: its perceived points'
+box with one side vertical) is `release_height` above the table. The IK is local,
 so every pose is tried from several seeds (the start posture, IIWA_HOME and postures turned
 towards the target). The joint trajectories between these configurations come from
 `tg_drake.planning.trajectory.plan_segment` (kinematic trajectory optimisation, collision checked
@@ -180,6 +181,8 @@ class Plan:
     # no hand-over
     handover: object | None = None  # pass: the receiver's motion (planning.handover.
     # HandoverMotion, its grasp and part), in plan time; None: no hand-over
+    t_descend: float | None = None  # [s] the descent to the place pose begins (the carry and
+    # any pour are over); None: not recorded
     regrasp: bool = False  # the plan ends with the object placed in an intermediate resting pose
     # and the arm back at its start (out of the camera's view): a place-and-regrasp's first leg
     # (tg_drake.planning.regrasp); the supervisor looks again and plans the next leg
@@ -224,15 +227,52 @@ class PlanResult:
 
 
 def place_pose(X_WO: np.ndarray, extents, place_xy, *, table_z: float = 0.0,
-               release_height: float = 0.01) -> np.ndarray:
+               release_height: float = 0.01, X_OB=None) -> np.ndarray:
     """X_WO moved to `place_xy` (world) with its orientation kept, its box's lowest corner
-    `release_height` above the table top at `table_z`."""
+    `release_height` above the table top at `table_z`. The box: sides `extents` [m], at X_OB
+    (4×4) in the object frame (None: centred on O, along its axes — the perceived box)."""
     corners = np.array(np.meshgrid(*[(-0.5, 0.5)] * 3)).reshape(3, -1).T * np.asarray(extents)
+    if X_OB is not None:
+        X_OB = np.asarray(X_OB, float)
+        corners = corners @ X_OB[:3, :3].T + X_OB[:3, 3]
     lowest = np.min((X_WO[:3, :3] @ corners.T)[2])  # relative to the origin of O
     X = X_WO.copy()
     X[:2, 3] = place_xy
     X[2, 3] = table_z + release_height - lowest
     return X
+
+
+@dataclass(frozen=True)
+class CarriedBox:
+    """The box the planner carries in the hand and sets down for a target: its perceived points'
+    box with one side vertical as the object rests now (the other two along the points'
+    principal horizontal directions), in the object frame O. Kept level, it sets the object
+    down at the height its points rest at now: the perceived box (`ObjectDescription.extents`)
+    follows the object's axes, and of a lying object turned about its axis (a mug whose handle
+    points up at a slant) its lowest corner lies centimetres under the points, which put the
+    object down that much too high, to drop and roll."""
+
+    X_OB: np.ndarray  # 4×4 pose of the box's centre and axes in O
+    size: tuple[float, float, float]  # [m] its sides
+
+
+def carried_box(target: ObjectDescription) -> CarriedBox:
+    """The `CarriedBox` of a perceived object (the perceived box itself when it has fewer than
+    four points)."""
+    p = np.asarray(target.p_W, float).reshape(-1, 3)
+    X_WO = np.asarray(target.X_WO, float)
+    if len(p) < 4:
+        return CarriedBox(np.eye(4), tuple(float(e) for e in target.extents))
+    xy = p[:, :2] - p[:, :2].mean(axis=0)
+    _, vecs = np.linalg.eigh(xy.T @ xy)
+    x = np.append(vecs[:, 1], 0.0)
+    R_WB = np.column_stack([x, np.cross([0.0, 0.0, 1.0], x), [0.0, 0.0, 1.0]])
+    q = p @ R_WB
+    lo, hi = q.min(axis=0), q.max(axis=0)
+    X_WB = np.eye(4)
+    X_WB[:3, :3] = R_WB
+    X_WB[:3, 3] = R_WB @ (0.5 * (lo + hi))
+    return CarriedBox(np.linalg.inv(X_WO) @ X_WB, tuple(float(v) for v in hi - lo))
 
 
 def plan_for_scene(scene: SceneDescription, candidates: GraspCandidates, *, place_xy, q_start,
@@ -308,18 +348,19 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
               else np.asarray(candidates.source, int))
 
     X_WO = np.asarray(target.X_WO, float)
-    X_WO_place = place_pose(X_WO, target.extents, place_xy, table_z=table_z,
-                            release_height=config.release_height)
+    held = carried_box(target)
+    X_WO_place = place_pose(X_WO, held.size, place_xy, table_z=table_z,
+                            release_height=config.release_height, X_OB=held.X_OB)
     if placing is not None:
         place_xy = placing.place_xy
-        X_WO_place = place_pose(X_WO, target.extents, place_xy, table_z=placing.support_z,
-                                release_height=config.release_height)
+        X_WO_place = place_pose(X_WO, held.size, place_xy, table_z=placing.support_z,
+                                release_height=config.release_height, X_OB=held.X_OB)
     boxes = [(f"object{i}", RigidTransform(o.X_WO), tuple(o.extents))
              for i, o in enumerate(obstacles)]
     boxes += [(f"surface_{s.name}", RigidTransform(np.asarray(s.X_WB)), tuple(s.size))
               for s in surfaces]
-    arms = _Arms(scenario, config.open_width, boxes, target_shapes(target), target.extents,
-                 X_WO=X_WO)
+    arms = _Arms(scenario, config.open_width, boxes, target_shapes(target), held.size,
+                 X_WO=X_WO, X_OB=held.X_OB)
     bearing = float(np.arctan2(X_WO[1, 3], X_WO[0, 3]))
     seeds = _seeds(q_start, config.seed_postures, bearing)
 
@@ -339,7 +380,8 @@ def plan_pick_and_place(candidates: GraspCandidates, *, target: ObjectDescriptio
         X_WG = np.asarray(candidates.X_WG[i], float)
         found = False
         places = _task_place_variants(X_WO_place, config, placing=placing, X_WO=X_WO,
-                                      X_WG=X_WG, extents=target.extents, is_tool=target.is_tool)
+                                      X_WG=X_WG, extents=held.size, is_tool=target.is_tool,
+                                      X_OB=held.X_OB)
         if handover is not None:  # a pass: handed over in the air (planning.handover), where
             # the arm can reach with this grasp
             places = [(None, X) for X in handover_object_poses(
@@ -479,17 +521,18 @@ def _place_variants(X_WO_place: np.ndarray, config: PlannerConfig) -> list[np.nd
 
 def _task_place_variants(X_WO_place: np.ndarray, config: PlannerConfig, *,
                          placing: TaskPlacing | None, X_WO: np.ndarray, X_WG: np.ndarray,
-                         extents, is_tool: bool = False) -> list[tuple]:
+                         extents, is_tool: bool = False, X_OB=None) -> list[tuple]:
     """(R_turn, X_WO_place) to try for grasp X_WG: the task's place poses (`placing`), each
     turned about the vertical by `config.place_yaws` (`_place_variants`). R_turn is the world
     rotation the plan gives the object when it turns it into another resting pose (the yaw
-    included), None when its orientation is kept."""
+    included), None when its orientation is kept. `extents`, `X_OB`: the box set down
+    (`place_pose`)."""
     if placing is None:
         return [(None, X) for X in _place_variants(X_WO_place, config)]
     out = []
     for R_turn, X_place in placing.place_poses(X_WO, X_WG, extents, is_tool=is_tool,
                                                release_height=config.release_height,
-                                               place_pose=place_pose):
+                                               place_pose=place_pose, X_OB=X_OB):
         for X in _place_variants(X_place, config):
             turn = None if R_turn is None else X[:3, :3] @ np.asarray(X_WO)[:3, :3].T
             out.append((turn, X))
@@ -581,15 +624,17 @@ class _Arms:
     out of a placed object is judged as going into it was (the object's whole box there would put
     fingers that straddle a wall or a rim inside it).
 
-    `extents`: the target's box [m] (held in the hand); `X_WO`: the target's pose now, where
-    `target_shapes` stand."""
+    `extents`: the box held in the hand [m], at X_OB in the object frame (None: the perceived
+    box, centred on O; `carried_box`); `X_WO`: the target's pose now, where `target_shapes`
+    stand."""
 
-    def __init__(self, scenario, opening, boxes, target_shapes, extents, *, X_WO):
+    def __init__(self, scenario, opening, boxes, target_shapes, extents, *, X_WO, X_OB=None):
         self._scenario, self._opening = scenario, opening
         self._boxes, self._target = list(boxes), list(target_shapes)
         self._X_OW = RigidTransform(np.asarray(X_WO, float)).inverse()
         self._cache: dict = {}
         self._held_size = tuple(extents)  # the object's box [m], carried in the hand
+        self._X_OB = RigidTransform() if X_OB is None else RigidTransform(np.asarray(X_OB, float))
 
     def _make(self, key, extra=(), held=None, finger_contact=()) -> ArmPlant:
         if key not in self._cache:
@@ -613,7 +658,7 @@ class _Arms:
 
     def carry(self, X_GO: RigidTransform) -> ArmPlant:
         key = ("carry", tuple(np.round(X_GO.GetAsMatrix4().ravel(), 9)))
-        return self._make(key, held=(X_GO, self._held_size))
+        return self._make(key, held=(X_GO @ self._X_OB, self._held_size))
 
 
 def placed_shapes(shapes, X_OW: RigidTransform, X_WO_place) -> list[tuple]:
@@ -839,6 +884,7 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
         t_pour = (t, t + key.pour_hold)
         add_hold(q["pour"], key.pour_hold)
         add_motion("return")
+    t_descend = t
     add_motion("descend")
     motion = None
     if receiving is not None:  # a pass: held until the receiver has closed
@@ -861,7 +907,7 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
                 t_place_done=t_place_done, duration=t, candidate=candidate, part=part,
                 X_WG_grasp=key.X["grasp"].GetAsMatrix4(),
                 X_WO_place=key.X_WO_place, waypoints=q, segments=tuple(rows),
-                R_turn=key.R_turn, t_pour=t_pour,
+                R_turn=key.R_turn, t_pour=t_pour, t_descend=t_descend,
                 t_handover=None if motion is None else (motion.t_closed, t_place_done),
                 handover=motion)
     return plan, "", True

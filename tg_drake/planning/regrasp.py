@@ -52,6 +52,7 @@ from tg_drake.planning.planner import (
     _task_place_variants,
     _waypoint_configurations,
     budget_reason,
+    carried_box,
     place_pose,
     plan_for_scene,
     plan_pick_and_place,
@@ -164,14 +165,15 @@ def second_leg_reachable(moved: ObjectDescription, parts, *, placing: TaskPlacin
     if not order:
         return "no pre-grasp hypothesis on " + ", ".join(parts)
     X_WO = np.asarray(moved.X_WO, float)
-    X_place0 = place_pose(X_WO, moved.extents, placing.place_xy, table_z=placing.support_z,
-                          release_height=config.release_height)
+    held = carried_box(moved)
+    X_place0 = place_pose(X_WO, held.size, placing.place_xy, table_z=placing.support_z,
+                          release_height=config.release_height, X_OB=held.X_OB)
     boxes = [(f"object{i}", RigidTransform(o.X_WO), tuple(o.extents))
              for i, o in enumerate(obstacles)]
     boxes += [(f"surface_{s.name}", RigidTransform(np.asarray(s.X_WB)), tuple(s.size))
               for s in surfaces]
-    arms = _Arms(scenario, config.open_width, boxes, target_shapes(moved), moved.extents,
-                 X_WO=X_WO)
+    arms = _Arms(scenario, config.open_width, boxes, target_shapes(moved), held.size,
+                 X_WO=X_WO, X_OB=held.X_OB)
     seeds = _seeds(q_start, config.seed_postures, float(np.arctan2(X_WO[1, 3], X_WO[0, 3])))
     centroid = np.asarray(moved.p_W, float).mean(axis=0) if len(moved.p_W) else None
     why = ""
@@ -186,7 +188,7 @@ def second_leg_reachable(moved: ObjectDescription, parts, *, placing: TaskPlacin
             continue
         for R_turn, X_place in _task_place_variants(X_place0, config, placing=placing,
                                                     X_WO=X_WO, X_WG=X_WG,
-                                                    extents=moved.extents,
+                                                    extents=held.size, X_OB=held.X_OB,
                                                     is_tool=moved.is_tool):
             key = _key_poses(arms, X_WG, X_WO, X_place, config, R_turn=R_turn)
             if any(key.X[n].translation()[2] < table_z for n in ("pre-grasp", "grasp")):
@@ -327,8 +329,9 @@ def _back_to_start(plan, q_start, target: ObjectDescription, obstacles, surfaces
              for i, o in enumerate(obstacles)]
     boxes += [(f"surface_{s.name}", RigidTransform(np.asarray(s.X_WB)), tuple(s.size))
               for s in surfaces]
-    arms = _Arms(scenario, config.open_width, boxes, target_shapes(target), target.extents,
-                 X_WO=target.X_WO)
+    held = carried_box(target)
+    arms = _Arms(scenario, config.open_width, boxes, target_shapes(target), held.size,
+                 X_WO=target.X_WO, X_OB=held.X_OB)
     q_end = plan.q(plan.duration)
     seeds = _seeds(q_start, config.seed_postures, 0.0)
     segment = plan_segment(arms.placed(plan.X_WO_place), q_end, np.asarray(q_start, float),

@@ -31,6 +31,7 @@ Each place pose is also turned about the vertical by `PlannerConfig.place_yaws`.
 """
 
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -271,10 +272,11 @@ class TaskPlacing:
         return self.fill_open + self.fill_settle if self.fill_at is not None else self.pour_hold
 
     def place_poses(self, X_WO: np.ndarray, X_WG: np.ndarray, extents, *, is_tool: bool,
-                    release_height: float, place_pose) -> list[tuple]:
+                    release_height: float, place_pose, X_OB=None) -> list[tuple]:
         """(R_turn or None, X_WO_place) for the grasp X_WG, before the yaw variants; [] when the
         object cannot be turned into the pose. `place_pose` is the planner's
-        (`tg_drake.planning.planner.place_pose`)."""
+        (`tg_drake.planning.planner.place_pose`), `extents` and `X_OB` the box it sets down."""
+        place_pose = functools.partial(place_pose, X_OB=X_OB)
         X_WO = np.asarray(X_WO, float)
         R_WG = np.asarray(X_WG, float)[:3, :3]
         if self.R_place is not None:  # an exact orientation: one turn, each release height

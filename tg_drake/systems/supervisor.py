@@ -227,7 +227,7 @@ class _Memory:
     status: PlanStatus | None = None  # the planner's answer with the plan being executed
     checks_passed: int = 0  # execution checks passed: 1 grasp closed, 2 lift done, 3 the pour
     # held over the bowl (pour plans) or arrived at the hand-over still held (pass), 4 (pass)
-    # the robot let go
+    # the robot let go; a place: still held as the descent begins (3, or 4 after a pour)
     z_G_grasped: float = 0.0  # [m] gripper body height when the grasp closed
     z_O_grasped: float = 0.0  # [m] object height when the grasp closed
     X_WO_picked: RigidTransform | None = None  # object pose when the plan started
@@ -549,7 +549,11 @@ class Supervisor(LeafSystem):
         # then it has let go
         handover = () if t_handover is None else (
             max(plan.handover.t_arrive, plan.t_lift_done), t_handover[1])
-        key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, *handover, plan.duration)
+        # a place: the descent begins (it must still hold the object)
+        t_descend = getattr(plan, "t_descend", None)
+        carried = () if handover or t_descend is None else (max(t_descend, plan.t_lift_done),)
+        key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, *handover, *carried,
+                     plan.duration)
         key_time = key_times[memory.checks_passed]
         if memory.t_released is not None and t < key_time:  # pass: the height while held
             X = self._poses_port.Eval(context)[self._model.object_body]
@@ -587,6 +591,12 @@ class Supervisor(LeafSystem):
             return dataclasses.replace(memory, checks_passed=2)
         if memory.checks_passed == 2 and pour:  # the pour's hold is over
             return dataclasses.replace(memory, checks_passed=3, held_at_pour=hand.held)
+        if carried and memory.checks_passed == 2 + len(pour):  # over the place, descending
+            if not hand.held:
+                return self._finish(memory, Status.lifted, Reason.slipped,
+                                    f"lost during the carry: not held as the descent to the "
+                                    f"place began ({hand.describe()})")
+            return dataclasses.replace(memory, checks_passed=memory.checks_passed + 1)
         if memory.checks_passed == 2 and handover:  # pass: arrived at the hand-over pose
             if not hand.held:
                 return self._finish(memory, Status.lifted, Reason.slipped,
