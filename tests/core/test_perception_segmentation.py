@@ -219,3 +219,44 @@ def test_the_near_and_far_walls_of_an_open_container_are_one_object():
     q = np.concatenate([near, low])
     labels = np.r_[np.zeros(len(near), int), np.ones(len(low), int)]
     assert list(_merge_shared_rims(q, labels, 2, cfg)) == [0, 1]
+
+
+
+def _d415_objects(meshes, seed, cfg=None):
+    from tg_drake.perception.sensor_model import StructuredLight, apply_sensor
+
+    K415 = Intrinsics.from_fov(640, 480, np.deg2rad(45.0))
+    X = S.look_at(np.array([0.8, 0.0, 0.55]), np.array([0.0, 0.0, 0.05]))  # ~0.95 m away
+    depth = apply_sensor(S.render_depth([S.table_mesh(), *meshes], K415, X), K415,
+                         StructuredLight(), seed=seed)
+    seg = segment_depth(depth, K415, X, cfg)
+    return [transform(seg.X_WT, q) for q in seg.objects_T]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_tables_noise_at_an_objects_foot_is_not_the_object(seed):
+    """An upright can (r 30 mm) through the D415 model: the table's noise that crosses the
+    height threshold beside its foot is not joined to it (`segmentation.foot_noise`): every
+    point lies within 9 mm of the wall (with the filter off, voxels up to 17 mm out), and its
+    foot stays (its lowest points within 6 mm of the table)."""
+    can = S.cylinder(0.03, 0.1)
+    (p,) = _d415_objects([can], seed)
+    assert np.hypot(p[:, 0], p[:, 1]).max() < 0.03 + 0.009
+    assert p[:, 2].min() < 0.006
+    (q,) = _d415_objects([can], seed, SegmentationConfig(foot_noise_sigmas=0.0))
+    assert len(q) > len(p)
+
+
+@pytest.mark.parametrize("seed", range(3))
+@pytest.mark.parametrize("blade_mm", [5, 6])
+def test_a_flat_blade_beside_a_raised_handle_keeps_its_blade(seed, blade_mm):
+    """A knife lying flat: a 5–6 mm blade (above the height threshold, inside the table's noise
+    band) beyond a 20 mm handle's end. Out from the handle's footprint, but the table there is
+    raised all along: the blade stays, its full length, and only the noise beside it goes (the
+    blade is 30 mm wide: with the filter off, points 12–27 mm beyond its sides)."""
+    handle = S.placed(S.box((0.02, 0.1, 0.02)), make_transform(np.eye(3), [0.0, -0.06, 0.0]))
+    blade = S.placed(S.box((0.03, 0.12, blade_mm / 1000)),
+                     make_transform(np.eye(3), [0.0, 0.05, 0.0]))
+    (p,) = _d415_objects([handle, blade], seed)
+    assert p[:, 1].min() < -0.105 and p[:, 1].max() > 0.105  # handle end to blade tip
+    assert np.abs(p[:, 0]).max() < 0.015 + 0.008

@@ -34,6 +34,11 @@ class SegmentationConfig:
     # alone they make no object (a cluster needs min_cluster_points voxels).
     thin_min_height: float = 0.001  # [m] half the thinnest object to be seen (2 mm)
     thin_min_cell_points: int = 6  # a cell with fewer points says nothing
+    # The table's noise at an object's foot (segmentation.foot_noise): a voxel within this many
+    # σ of the table's height noise (4.5σ: one-sided 3·10⁻⁶ of a normal; 8 mm at 1 m through the
+    # D415), out from the footprint of the object above that band, on table that is not raised,
+    # is not the object. 0 keeps every voxel DBSCAN joined.
+    foot_noise_sigmas: float = 4.5
     # A raised cell's points never join an object the height threshold sees, unless that object
     # lies flat: the median height of its points is below this [m] (a blade whose noise crosses
     # the threshold here and there; a can's or a handle's is far above it).
