@@ -122,19 +122,29 @@ def table_noise_scale(height: np.ndarray, range_m: np.ndarray, table: np.ndarray
     return 1.4826 * float(np.median(np.abs(u - np.median(u))))
 
 
-def _disc_medians(xy: np.ndarray, xy_all: np.ndarray, h_all: np.ndarray, r2_all: np.ndarray,
-                  radius: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """For each point xy (M, 2): the median height of the points (xy_all, h_all) within `radius`
-    of it on the table, their count and their mean range² (r2_all)."""
-    hood = cKDTree(xy_all).query_ball_point(xy, radius)
-    n = np.array([len(nb) for nb in hood])
-    m = np.zeros(len(xy))
-    mean_r2 = np.zeros(len(xy))
-    for k, nb in enumerate(hood):
-        if nb:
-            m[k] = float(np.median(h_all[nb]))
-            mean_r2[k] = float(np.mean(r2_all[nb]))
-    return m, n, mean_r2
+def _raised_discs(centres: np.ndarray, xy: np.ndarray, h: np.ndarray, r2: np.ndarray, a: float,
+                  cfg: SegmentationConfig) -> np.ndarray:
+    """(M,) bool: is the table raised around each of `centres` (M, 2)? The points (xy (N, 2),
+    heights h (N,), squared camera ranges r2 (N,)) within the disc of a `thin_cell` square's area
+    of a centre: at least `thin_min_cell_points` of them, their median height above
+    `thin_min_height` and above `thin_significance` of its standard error, 1.2533·a·mean(r2)/√n
+    (the table's noise σ = a·range², `table_noise_scale`)."""
+    hood = cKDTree(xy).query_ball_point(centres, cfg.thin_cell / np.sqrt(np.pi))
+    n = np.array([len(nb) for nb in hood], int)
+    if not n.any():
+        return np.zeros(len(centres), bool)
+    owner = np.repeat(np.arange(len(centres)), n)
+    nb = np.concatenate(hood).astype(int)
+    by = np.lexsort((h[nb], owner))  # each disc's heights in order
+    first = np.r_[0, np.cumsum(n)[:-1]]
+    hs = h[nb][by]
+    has = np.flatnonzero(n)
+    m = np.zeros(len(centres))
+    m[has] = 0.5 * (hs[first[has] + (n[has] - 1) // 2] + hs[first[has] + n[has] // 2])
+    k = np.maximum(n, 1)
+    error = 1.2533 * a * np.bincount(owner, weights=r2[nb], minlength=len(centres)) / k / np.sqrt(k)
+    return ((n >= cfg.thin_min_cell_points) & (m > cfg.thin_min_height)
+            & (m > cfg.thin_significance * error))
 
 
 def foot_noise(q: np.ndarray, p_T: np.ndarray, height: np.ndarray, range_q: np.ndarray,
@@ -171,11 +181,8 @@ def foot_noise(q: np.ndarray, p_T: np.ndarray, height: np.ndarray, range_q: np.n
                           & (height <= cfg.foot_noise_sigmas * a * range_m ** 2))
     if len(near) == 0:
         return out
-    m, n, mean_r2 = _disc_medians(q[outside, :2], p_T[near, :2], height[near],
-                                  range_m[near] ** 2, cfg.thin_cell / np.sqrt(np.pi))
-    error = 1.2533 * a * mean_r2 / np.sqrt(np.maximum(n, 1))
-    raised = ((n >= cfg.thin_min_cell_points) & (m > cfg.thin_min_height)
-              & (m > cfg.thin_significance * error))
+    raised = _raised_discs(q[outside, :2], p_T[near, :2], height[near], range_m[near] ** 2, a,
+                           cfg)
     out[outside[~raised]] = True
     return out
 
@@ -229,19 +236,7 @@ def raised_cells(p_T: np.ndarray, height: np.ndarray, range_m: np.ndarray,
             near |= np.isin(cells, raised_ids + di * width + dj)
     cand = order[np.repeat(near, counts)]
     xy = p_T[low[cand], :2]
-    tree = cKDTree(xy)
-    hood = tree.query_ball_point(xy, cfg.thin_cell / np.sqrt(np.pi))
-    h, r2 = height[low[cand]], range_m[low[cand]] ** 2
-    n = np.array([len(nb) for nb in hood])
-    owner = np.repeat(np.arange(len(cand)), n)
-    nb = np.concatenate(hood).astype(int)
-    by = np.lexsort((h[nb], owner))  # each disc's heights in order
-    first = np.r_[0, np.cumsum(n)[:-1]]
-    hs = h[nb][by]
-    m = 0.5 * (hs[first + (n - 1) // 2] + hs[first + n // 2])  # each disc's median
-    error = 1.2533 * a * np.bincount(owner, weights=r2[nb], minlength=len(cand)) / n / np.sqrt(n)
-    keep = ((n >= cfg.thin_min_cell_points) & (m > cfg.thin_min_height)
-            & (m > cfg.thin_significance * error))
+    keep = _raised_discs(xy, xy, height[low[cand]], range_m[low[cand]] ** 2, a, cfg)
     out[low[cand[keep]]] = True
     return out
 
@@ -397,8 +392,9 @@ def segment_cloud(p_W: np.ndarray, pixels: np.ndarray, image_size: tuple[int, in
     inside = np.all(p_T_all[:, :2] >= lo, axis=1) & np.all(p_T_all[:, :2] <= hi, axis=1)
     regular = inside & (height > cfg.min_object_height) & (height < cfg.max_object_height)
     found = _clusters(np.flatnonzero(regular), p_T_all, pixels, image_size, cfg)
-    thin = inside & raised_cells(p_T_all, height, np.linalg.norm(p_W - p_WC, axis=1),
-                                 np.abs(height) < cfg.plane_distance, cfg)
+    range_all = np.linalg.norm(p_W - p_WC, axis=1)
+    on_plane = np.abs(height) < cfg.plane_distance
+    thin = inside & raised_cells(p_T_all, height, range_all, on_plane, cfg)
     if thin.any():
         # A found object lying within thin_max_height of the table (its threshold-crossing
         # points a thin object's noise) is clustered again with the raised cells' points.
@@ -417,8 +413,7 @@ def segment_cloud(p_W: np.ndarray, pixels: np.ndarray, image_size: tuple[int, in
         found += [f for f in _clusters(rest, p_T_all, pixels, image_size, cfg)
                   if (thin | flat)[f[2]].any()]
     if found and cfg.foot_noise_sigmas > 0:
-        range_all = np.linalg.norm(p_W - p_WC, axis=1)
-        a = table_noise_scale(height, range_all, np.abs(height) < cfg.plane_distance)
+        a = table_noise_scale(height, range_all, on_plane)
         p_CT = transform(X_TW, np.asarray(p_WC, float)[None])[0]
         cleaned = []
         for q, is_cut, members in found:

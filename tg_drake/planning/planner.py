@@ -54,6 +54,7 @@ from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.errors import ScenarioError
 from tg_drake.logic.receive import receiver_parts
+from tg_drake.perception.geometry import inverse, make_transform
 from tg_drake.planning.handover import (
     Handover,
     choose_receiver_grasp,
@@ -269,10 +270,8 @@ def carried_box(target: ObjectDescription) -> CarriedBox:
     R_WB = np.column_stack([x, np.cross([0.0, 0.0, 1.0], x), [0.0, 0.0, 1.0]])
     q = p @ R_WB
     lo, hi = q.min(axis=0), q.max(axis=0)
-    X_WB = np.eye(4)
-    X_WB[:3, :3] = R_WB
-    X_WB[:3, 3] = R_WB @ (0.5 * (lo + hi))
-    return CarriedBox(np.linalg.inv(X_WO) @ X_WB, tuple(float(v) for v in hi - lo))
+    X_WB = make_transform(R_WB, R_WB @ (0.5 * (lo + hi)))
+    return CarriedBox(inverse(X_WO) @ X_WB, tuple(float(v) for v in hi - lo))
 
 
 def plan_for_scene(scene: SceneDescription, candidates: GraspCandidates, *, place_xy, q_start,

@@ -329,9 +329,8 @@ def _back_to_start(plan, q_start, target: ObjectDescription, obstacles, surfaces
              for i, o in enumerate(obstacles)]
     boxes += [(f"surface_{s.name}", RigidTransform(np.asarray(s.X_WB)), tuple(s.size))
               for s in surfaces]
-    held = carried_box(target)
-    arms = _Arms(scenario, config.open_width, boxes, target_shapes(target), held.size,
-                 X_WO=target.X_WO, X_OB=held.X_OB)
+    arms = _Arms(scenario, config.open_width, boxes, target_shapes(target), target.extents,
+                 X_WO=target.X_WO)  # (only `placed`: nothing is carried on the way back)
     q_end = plan.q(plan.duration)
     seeds = _seeds(q_start, config.seed_postures, 0.0)
     segment = plan_segment(arms.placed(plan.X_WO_place), q_end, np.asarray(q_start, float),

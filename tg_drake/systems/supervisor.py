@@ -551,7 +551,7 @@ class Supervisor(LeafSystem):
             max(plan.handover.t_arrive, plan.t_lift_done), t_handover[1])
         # a place: the descent begins (it must still hold the object)
         t_descend = getattr(plan, "t_descend", None)
-        carried = () if handover or t_descend is None else (max(t_descend, plan.t_lift_done),)
+        carried = () if handover or t_descend is None else (t_descend,)
         key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, *handover, *carried,
                      plan.duration)
         key_time = key_times[memory.checks_passed]
