@@ -286,30 +286,57 @@ def fit_circle(xy: np.ndarray) -> tuple[np.ndarray, float, float]:
     return centre, radius, rms
 
 
+def _circle_radii(stats: np.ndarray) -> np.ndarray:
+    """Radii [m] of the least-squares (Kåsa) circles whose normal equations are `stats` (..., 3,
+    4): [AᵀA | Aᵀb] summed over points, A = [2x, 2y, 1], b = x² + y² (fit_circle's system). NaN
+    where the system is singular."""
+    M, v = stats[..., :3], stats[..., 3]
+    out = np.full(M.shape[:-2], np.nan)
+    ok = np.abs(np.linalg.det(M)) > 1e-300
+    if ok.any():
+        cx, cy, k = np.moveaxis(np.linalg.solve(M[ok], v[ok][..., None])[..., 0], -1, 0)
+        out[ok] = np.sqrt(np.maximum(k + cx * cx + cy * cy, 0.0))
+    return out
+
+
 def _merge_shared_rims(q: np.ndarray, labels: np.ndarray, n: int, cfg: SegmentationConfig
                        ) -> np.ndarray:
     """Cluster id → merged cluster id, joining two clusters whose tops lie on one circle: the
     near and the far wall of an open container whose rim between them the camera lost (a wide
     pot seen from above: the inside's floor hidden, the rim's sides thinner than the sensor's
-    edge losses). q: (M, 3) voxel points in T [m]; labels (M,) their cluster (−1: noise)."""
-    tops = []
+    edge losses). q: (M, 3) voxel points in T [m]; labels (M,) their cluster (−1: noise).
+
+    A pair needs the circle's radius at most each top's longest side (each top an arc of it, not
+    a blob beside it); that radius comes for every pair at once from the normal equations, which
+    add over the two tops, and only pairs within 1 % of it are fitted point by point
+    (fit_circle)."""
+    order = np.argsort(labels, kind="stable")
+    bounds = np.searchsorted(labels[order], np.arange(n + 1))
+    origin = q[:, :2].mean(axis=0) if len(q) else np.zeros(2)  # the fit does not depend on it
+    tops, z_top, side = [], np.full(n, np.nan), np.zeros(n)
+    stats = np.zeros((n, 3, 4))
     for k in range(n):
-        z = q[labels == k, 2]
-        tops.append((q[labels == k][z >= z.max() - cfg.rim_band] if len(z) else q[:0],
-                     z.max() if len(z) else np.nan))
+        pts = q[order[bounds[k]:bounds[k + 1]]]
+        top = pts[pts[:, 2] >= pts[:, 2].max() - cfg.rim_band] if len(pts) else pts
+        tops.append(top)
+        if len(top) >= 3:
+            z_top[k] = pts[:, 2].max()
+            side[k] = np.ptp(top[:, :2], axis=0).max()
+            xy = top[:, :2] - origin
+            A = np.column_stack([2 * xy, np.ones(len(xy))])
+            stats[k] = A.T @ np.column_stack([A, (xy ** 2).sum(axis=1)])
+    i, j = np.triu_indices(n, 1)
+    pair = np.abs(z_top[i] - z_top[j]) <= cfg.rim_band  # NaN (under 3 top points): False
+    i, j = i[pair], j[pair]
+    radius = _circle_radii(stats[i] + stats[j])
+    maybe = ~(radius > 1.01 * np.minimum(side[i], side[j]) + 1e-6)  # NaN: fit it
     parent = np.arange(n)
-    for i in range(n):
-        for j in range(i + 1, n):
-            (ti, zi), (tj, zj) = tops[i], tops[j]
-            if len(ti) < 3 or len(tj) < 3 or not abs(zi - zj) <= cfg.rim_band:
-                continue
-            both = np.concatenate([ti[:, :2], tj[:, :2]])
-            centre, radius, rms = fit_circle(both)
-            # Each top alone must be an arc of that circle, not a blob beside it.
-            if rms <= cfg.rim_fit_rms and radius > 0 and all(
-                    np.ptp(t[:, :2], axis=0).max() >= radius for t in (ti, tj)):
-                a, b = parent[i], parent[j]
-                parent[parent == max(a, b)] = min(a, b)
+    for a, b in zip(i[maybe].tolist(), j[maybe].tolist(), strict=True):
+        ta, tb = tops[a], tops[b]
+        _, radius, rms = fit_circle(np.concatenate([ta[:, :2], tb[:, :2]]))
+        if rms <= cfg.rim_fit_rms and radius > 0 and min(side[a], side[b]) >= radius:
+            ra, rb = parent[a], parent[b]
+            parent[parent == max(ra, rb)] = min(ra, rb)
     return parent
 
 
