@@ -16,11 +16,15 @@ view). Two fits on these views:
 
     .venv/bin/python tools/calibrate_pose.py  # → tg_drake/data/pose_likelihood.json
     .venv/bin/python tools/calibrate_pose.py --sensor ideal --out /tmp/pose.json
-    .venv/bin/python tools/calibrate_pose.py --sensor d415 --no-closed-end --out /tmp/pose.json
+    .venv/bin/python tools/calibrate_pose.py --no-closed-end --out /tmp/pose.json
+    .venv/bin/python tools/calibrate_pose.py --closed-end-from tg_drake/data/pose_likelihood.json
 
 `--no-closed-end` skips step 1 (the closed-end cue off). With it, the closed-end decisions of
 step 2 are `pose.closed_end_decision`'s: what the model reads as a base is a base only with
 evidence other than the missing lid (an end pushed in, or a wall narrowing from the table up).
+`--closed-end-from FILE` skips step 1 too but keeps the closed-end model of FILE (an earlier
+calibration): step 2 recounts with it. Either way the tool prints the training accuracy of the
+model it used and of the one step 1 fits, so that the model kept is chosen on training views.
 """
 
 from __future__ import annotations
@@ -99,12 +103,26 @@ def flat_sign(views: list[tuple], model: ClosedEndModel | None) -> float:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sensor", choices=("default", "ideal", "d415"), default="default")
+    parser.add_argument("--sensor", choices=("default", "ideal", "d415"), default="d415",
+                        help="the depth sensor of the views: the evaluation's D415 model "
+                             "(default), the ideal one, or the default scenario camera's")
     parser.add_argument("--out", type=Path, default=CALIBRATION_FILE)
     parser.add_argument("--no-closed-end", dest="closed_end", action="store_false",
                         help="do not fit the closed-end model (the file then holds none: the "
                              "closed-end cue is off)")
+    parser.add_argument("--closed-end-from", type=Path, metavar="FILE",
+                        help="keep the closed-end model of this calibration file instead of "
+                             "fitting one, and recount the decisions with it")
     args = parser.parse_args(argv)
+    kept = None
+    if args.closed_end_from is not None:
+        try:
+            c = json.loads(args.closed_end_from.read_text())["closed_end"]
+            kept = ClosedEndModel(weights=tuple(float(w) for w in c["weights"]),
+                                  bias=float(c["bias"]))
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            parser.error(f"--closed-end-from {args.closed_end_from}: no closed-end model "
+                         f"({type(e).__name__}: {e})")
     sensor = {"default": DepthPerception().sensor, "ideal": IdealDepth(),
               "d415": StructuredLight()}[args.sensor]
     counts: dict = collections.defaultdict(lambda: collections.Counter())
@@ -123,10 +141,11 @@ def main(argv=None) -> int:
     if failed == n:
         print("no view perceived", file=sys.stderr)
         return 1
-    model, n_end = fit_closed_end(views) if args.closed_end else (None, 0)
-    if model is None and args.closed_end:
+    fitted, n_end = fit_closed_end(views) if args.closed_end else (None, 0)
+    if fitted is None and args.closed_end:
         print("the closed-end model needs upright and upside-down views: not fitted",
               file=sys.stderr)
+    model = kept if kept is not None else fitted
     sign = flat_sign(views, model)
     for pose, d in views:
         counts["/".join(decide(d, model, sign))][pose] += 1
@@ -140,6 +159,12 @@ def main(argv=None) -> int:
         out["closed_end"] = {"weights": list(model.weights), "bias": model.bias,
                              "features": "recess [mm], dome [mm], recess² [mm²]",
                              "views": n_end, "C": CLOSED_END_C}
+        if kept is not None:  # where it came from: how that calibration was made
+            earlier = json.loads(args.closed_end_from.read_text())
+            end = earlier["closed_end"]
+            out["closed_end"] |= {"views": end.get("views"), "C": end.get("C"),
+                                  "kept_from": end.get("kept_from", "an earlier calibration: "
+                                                       + earlier.get("source", "?"))}
     args.out.write_text(json.dumps(out, indent=1) + "\n")
     calibration = PoseCalibration(counts=out["counts"], prior_views=PRIOR_VIEWS)
     for key in out["counts"]:
@@ -147,11 +172,13 @@ def main(argv=None) -> int:
         p = calibration.likelihood(decision, cue)
         print(f"{key:22s} {dict(out['counts'][key])}  →  " + ", ".join(
             f"{k} {v:.2f}" for k, v in p.items()))
-    if model is not None:
-        ends = [(pose, ClosedEnd(*d.pose_end[:4])) for pose, d in views if d.pose_end is not None
-                and pose in ("upright", "upsidedown")]
-        right = sum((model.p_upsidedown(e) > 0.5) == (pose == "upsidedown") for pose, e in ends)
-        print(f"closed-end model on {n_end} views: training accuracy {right / len(ends):.3f}")
+    ends = [(pose, ClosedEnd(*d.pose_end[:4])) for pose, d in views if d.pose_end is not None
+            and pose in ("upright", "upsidedown")]
+    for name, m in (("kept from " + str(args.closed_end_from), kept), ("fitted", fitted)):
+        if m is not None and ends:
+            right = sum((m.p_upsidedown(e) > 0.5) == (pose == "upsidedown") for pose, e in ends)
+            print(f"closed-end model, {name}: training accuracy {right / len(ends):.3f} on "
+                  f"{len(ends)} views")
     print(f"wrote {args.out} ({n} views, {failed} not perceived)")
     return 0
 
