@@ -22,9 +22,9 @@ view). Two fits on these views:
 `--no-closed-end` skips step 1 (the closed-end cue off). With it, the closed-end decisions of
 step 2 are `pose.closed_end_decision`'s: what the model reads as a base is a base only with
 evidence other than the missing lid (an end pushed in, or a wall narrowing from the table up).
-`--closed-end-from FILE` skips step 1 too but keeps the closed-end model of FILE (an earlier
-calibration): step 2 recounts with it. Either way the tool prints the training accuracy of the
-model it used and of the one step 1 fits, so that the model kept is chosen on training views.
+`--closed-end-from FILE` uses the closed-end model of FILE (an earlier calibration) in step 2
+instead of step 1's fit; step 1 still runs, and the tool prints the training accuracy of both
+models, so that the model kept is chosen on training views.
 """
 
 from __future__ import annotations
@@ -114,10 +114,11 @@ def main(argv=None) -> int:
                         help="keep the closed-end model of this calibration file instead of "
                              "fitting one, and recount the decisions with it")
     args = parser.parse_args(argv)
-    kept = None
+    kept = earlier = None
     if args.closed_end_from is not None:
         try:
-            c = json.loads(args.closed_end_from.read_text())["closed_end"]
+            earlier = json.loads(args.closed_end_from.read_text())
+            c = earlier["closed_end"]
             kept = ClosedEndModel(weights=tuple(float(w) for w in c["weights"]),
                                   bias=float(c["bias"]))
         except (OSError, ValueError, KeyError, TypeError) as e:
@@ -160,7 +161,6 @@ def main(argv=None) -> int:
                              "features": "recess [mm], dome [mm], recess² [mm²]",
                              "views": n_end, "C": CLOSED_END_C}
         if kept is not None:  # where it came from: how that calibration was made
-            earlier = json.loads(args.closed_end_from.read_text())
             end = earlier["closed_end"]
             out["closed_end"] |= {"views": end.get("views"), "C": end.get("C"),
                                   "kept_from": end.get("kept_from", "an earlier calibration: "
