@@ -221,7 +221,6 @@ def test_the_near_and_far_walls_of_an_open_container_are_one_object():
     assert list(_merge_shared_rims(q, labels, 2, cfg)) == [0, 1]
 
 
-
 def _rims_one_pair_at_a_time(q, labels, n, cfg):
     """The rule of _merge_shared_rims written out pair by pair, every pair fitted."""
     from tg_drake.perception.segmentation import fit_circle
@@ -271,7 +270,6 @@ def test_shared_rims_among_many_clusters_are_those_every_pair_fitted_finds(seed)
     got = _merge_shared_rims(q, labels, n, cfg)
     assert list(got) == list(expected)
     assert list(got[:6]) == [0, 0, 2, 2, 4, 4]  # each container's two walls, one object
-
 
 
 def _d415_objects(meshes, seed, cfg=None):

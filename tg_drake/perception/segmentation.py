@@ -289,10 +289,10 @@ def fit_circle(xy: np.ndarray) -> tuple[np.ndarray, float, float]:
 def _circle_radii(stats: np.ndarray) -> np.ndarray:
     """Radii [m] of the least-squares (Kåsa) circles whose normal equations are `stats` (..., 3,
     4): [AᵀA | Aᵀb] summed over points, A = [2x, 2y, 1], b = x² + y² (fit_circle's system). NaN
-    where the system is singular."""
+    where the system is too ill-conditioned for the normal equations (the caller then fits)."""
     M, v = stats[..., :3], stats[..., 3]
     out = np.full(M.shape[:-2], np.nan)
-    ok = np.abs(np.linalg.det(M)) > 1e-300
+    ok = np.linalg.cond(M) < 1e10 if len(M) else np.zeros(0, bool)
     if ok.any():
         cx, cy, k = np.moveaxis(np.linalg.solve(M[ok], v[ok][..., None])[..., 0], -1, 0)
         out[ok] = np.sqrt(np.maximum(k + cx * cx + cy * cy, 0.0))
