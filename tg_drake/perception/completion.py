@@ -24,6 +24,10 @@ projected points W with a large confidence; the points lying outside it are hand
    the closest-dimensions rule alone would call it sideways.
 2. Handle points (outside the circle) are not rotated: the handle is the part that breaks the
    rotational symmetry, and rotating it would add a second, phantom handle.
+3. Given the camera, a rotated point is kept only where the camera could not have seen it
+   (`seen_free`): one axis rotates the whole object, so where a part is thinner than the axis is
+   high (the shaft of a screwdriver lying on the table, tilted from its thick handle to its tip;
+   a knife's flat blade) its copy floats above it, in space the camera looked through.
 
 The test works on the outline of the folded cross-section: the 180° rotation about the axis maps
 polar angle θ to θ + π, so the completed outline radius in direction θ is the largest radius
@@ -36,6 +40,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import minimum_filter
 
 from tg_drake.errors import PerceptionError
 from tg_drake.perception.config import CompletionConfig
@@ -158,7 +163,67 @@ def _rotate_180(p: np.ndarray, p_A: np.ndarray, a: np.ndarray) -> np.ndarray:
     return p_A + 2.0 * np.outer(d @ a, a) - d
 
 
-def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = None
+def seen_free(q: np.ndarray, p_seen: np.ndarray, p_C: np.ndarray, *, radius: float,
+              margin: float, occluders: np.ndarray | None = None) -> np.ndarray:
+    """(M,) bool: which points q (M, 3) lie in space the camera at p_C saw through: no observed
+    point p_seen (N, 3) within `radius` [m] of q's line of sight is nearer the camera than
+    `margin` [m] behind q (the camera saw past q, to a surface farther away or to none of the
+    object's: the table), and no point of `occluders` (K, 3; other objects) lies in front of q
+    there. All in one frame.
+
+    Works on a z-buffer of the observed points in a pinhole image about their mean direction,
+    pixels radius / 2 wide at their mean range, each pixel's nearest range spread over the
+    pixels within `radius` (a 5×5 minimum)."""
+    q = np.asarray(q, float).reshape(-1, 3)
+    p_seen = np.asarray(p_seen, float).reshape(-1, 3)
+    free = np.zeros(len(q), bool)
+    if not len(q) or not len(p_seen) or radius <= 0:
+        return free
+    P = p_seen - p_C
+    w = P.mean(axis=0)
+    w /= np.linalg.norm(w)
+    u = np.cross(w, [0.0, 0.0, 1.0] if abs(w[2]) < 0.9 else [1.0, 0.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(w, u)
+    pixel = 0.5 * radius / float(np.linalg.norm(P, axis=1).mean())
+
+    def image(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        depth = x @ w  # > 0: in front of the camera
+        ok = depth > 1e-6
+        safe = np.where(ok, depth, 1.0)
+        ij = np.floor(np.column_stack([x @ u, x @ v]) / (safe[:, None] * pixel)).astype(np.int64)
+        return ij, np.linalg.norm(x, axis=1), ok
+
+    ij_p, r_p, ok_p = image(P)
+    ij_q, r_q, ok_q = image(q - p_C)
+    both = np.vstack([ij_p[ok_p], ij_q[ok_q]])
+    if not len(both):
+        return free
+    lo = both.min(axis=0) - 2
+    shape = both.max(axis=0) - lo + 3
+
+    def nearest(ij: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """Each pixel's nearest range among the points (ij, r) within 2 pixels (inf: none)."""
+        k = ij - lo
+        on = np.all((k >= 0) & (k < shape), axis=1)
+        buffer = np.full(tuple(shape), np.inf)
+        np.minimum.at(buffer, tuple(k[on].T), r[on])
+        return minimum_filter(buffer, size=5, mode="constant", cval=np.inf)
+
+    k_q = tuple((ij_q[ok_q] - lo).T)
+    seen = np.full(len(q), np.inf)
+    seen[ok_q] = nearest(ij_p[ok_p], r_p[ok_p])[k_q]
+    free = ok_q & (seen > r_q + margin)
+    if occluders is not None and len(occluders) and free.any():
+        ij_o, r_o, ok_o = image(np.asarray(occluders, float).reshape(-1, 3) - p_C)
+        in_front = np.full(len(q), np.inf)
+        in_front[ok_q] = nearest(ij_o[ok_o], r_o[ok_o])[k_q]
+        free &= ~(in_front < r_q)  # another object between the camera and q hides q
+    return free
+
+
+def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = None,
+             p_TC: np.ndarray | None = None, occluders_T: np.ndarray | None = None
              ) -> Completion:
     """Completes the visible points P of one object by the paper's line-reflection symmetry.
 
@@ -166,6 +231,9 @@ def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = No
         p_T: (N, 3) visible points in the table frame (z = height above the table) [m].
         n_T: (N, 3) their unit normals, oriented towards the camera.
         cfg: completion parameters.
+        p_TC: (3,) the camera's position in T [m]: rotated points where the camera saw through
+            are dropped (`seen_free`); None: all are kept.
+        occluders_T: (K, 3) other objects' visible points in T [m], which may hide this one's.
     """
     cfg = cfg or CompletionConfig()
     p_T = np.asarray(p_T, float)
@@ -253,6 +321,10 @@ def complete(p_T: np.ndarray, n_T: np.ndarray, cfg: CompletionConfig | None = No
     body = ~handle
     p_rot = _rotate_180(p_T[body], p_TA, a)
     n_rot = _rotate_180(n_T[body], np.zeros(3), a)
+    if p_TC is not None:
+        hidden = ~seen_free(p_rot, p_T, np.asarray(p_TC, float), radius=cfg.free_space_radius,
+                            margin=cfg.free_space_margin, occluders=occluders_T)
+        p_rot, n_rot = p_rot[hidden], n_rot[hidden]
     p_all = np.concatenate([p_T, p_rot])
     n_all = np.concatenate([n_T, n_rot])
     # Outwards: away from the axis point (radially for walls, along the axis for end faces).

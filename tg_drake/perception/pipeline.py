@@ -35,7 +35,8 @@ BELOW_TABLE_TOLERANCE = 0.01
 
 
 def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
-                    cfg: PerceptionConfig | None = None) -> ObjectDescription:
+                    cfg: PerceptionConfig | None = None, occluders_T: np.ndarray | None = None
+                    ) -> ObjectDescription:
     """Describes one object from its visible points.
 
     Args:
@@ -44,6 +45,8 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
         X_WT: 4×4 table frame in the world.
         p_TC: (3,) camera position in T [m] (normals are oriented towards it).
         cfg: perception parameters.
+        occluders_T: (K, 3) the other objects' visible points in T [m] (they may hide parts of
+            this one from the camera: the completion keeps what is behind them).
     """
     cfg = cfg or PerceptionConfig()
     p_T = np.asarray(p_T, float)
@@ -64,7 +67,7 @@ def describe_object(p_T: np.ndarray, X_WT: np.ndarray, p_TC: np.ndarray,
         grid = cfg.segmentation.voxel_size * np.sqrt(len(p_T) / cfg.segmentation.max_object_points)
         p_T, _ = voxel_average(p_T, grid)
     n_T = estimate_normals(p_T, np.asarray(p_TC, float), cfg.completion.normal_neighbours)
-    c = complete(p_T, n_T, cfg.completion)
+    c = complete(p_T, n_T, cfg.completion, p_TC=p_TC, occluders_T=occluders_T)
     pose = estimate_pose(c, n_T, p_TC, cfg.pose)
     parts = segment_parts(c, pose.top_sign, cfg.parts)
     if parts.is_tool:
@@ -114,5 +117,7 @@ def describe_scene(depth: np.ndarray, intrinsics: Intrinsics, X_WC: np.ndarray,
     cfg = cfg or PerceptionConfig()
     seg = segment_depth(depth, intrinsics, X_WC, cfg.segmentation)
     p_TC = transform(inverse(seg.X_WT), np.asarray(X_WC, float)[:3, 3][None])[0]
-    objects = [describe_object(q, seg.X_WT, p_TC, cfg) for q in seg.objects_T]
+    objects = [describe_object(q, seg.X_WT, p_TC, cfg, occluders_T=np.concatenate(
+        [o for j, o in enumerate(seg.objects_T) if j != i] or [np.zeros((0, 3))]))
+        for i, q in enumerate(seg.objects_T)]
     return SceneDescription(objects=objects, X_WT=seg.X_WT)
