@@ -219,7 +219,7 @@ def test_a_colliding_pose_gets_no_hold():
 
 def test_the_assessed_candidates_keep_the_scorers_score(monkeypatch):
     """Local and one-part scoring rank otherwise than P(part | task) · P(grasp | local shape);
-    the stage multiplies their score by nothing but P(hold) (off by default) or 0."""
+    the stage multiplies their score by nothing but P(hold) (when it ranks by it) or 0."""
     from types import SimpleNamespace
 
     from tg_drake.grasping import feasibility
@@ -237,11 +237,13 @@ def test_the_assessed_candidates_keep_the_scorers_score(monkeypatch):
     local = np.array([0.9, 0.8, 0.7, 0.5])  # ranked by P(grasp | local shape) alone
     candidates = GraspCandidates(np.tile(np.eye(4), (4, 1, 1)), np.array([0, 3, 1, 1]),
                                  np.array([0.1, 0.0, 0.9, 0.9]), local, local.copy())
-    out = feasibility.assess_candidates(SceneDescription(objects=[obj], X_WT=np.eye(4)),
-                                        candidates, category=None, approach=0.1,
-                                        config=FeasibilityConfig())
-    assert np.allclose(out.score, [0.9, 0.8, 0.5, 0.0])  # the third is infeasible: 0, last
-    assert out.source.tolist() == [0, 1, 3, 2]
+    for rank_by_hold, p_hold in ((False, 1.0), (True, 0.5)):
+        out = feasibility.assess_candidates(SceneDescription(objects=[obj], X_WT=np.eye(4)),
+                                            candidates, category=None, approach=0.1,
+                                            config=FeasibilityConfig(rank_by_hold=rank_by_hold))
+        # The third is infeasible: 0, last.
+        assert np.allclose(out.score, p_hold * np.array([0.9, 0.8, 0.5, 0.0]))
+        assert out.source.tolist() == [0, 1, 3, 2]
 
 
 def test_why_no_pose_counts_each_favoured_parts_refusals_by_class():

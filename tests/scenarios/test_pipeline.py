@@ -78,10 +78,11 @@ def test_default_scenario_passes_the_cup_by_its_middle(cached_run):
     assert m["received_part"] in ("top", "bottom", "handle"), m
     assert f"by its {m['received_part']}" in result["task_outcome"]["detail"]
     assert "cup" in summary(result) and "handed over" in summary(result)
-    # P(hold) is reported beside the score, not as its factor, while the stage does not rank by it.
-    assert not result["config"]["pipeline"]["feasibility"]["rank_by_hold"]
+    # The stage ranks by P(hold): a factor of the executed pose's score, and the summary says so.
+    assert result["config"]["pipeline"]["feasibility"]["rank_by_hold"]
     grasp_line = next(line for line in summary(result).splitlines() if line.startswith("grasp"))
-    assert "not ranked by" in grasp_line and "× P(hold)" not in grasp_line
+    assert "× P(hold)" in grasp_line and "not ranked by" not in grasp_line
+    assert result["grasp"]["p_hold"] >= result["config"]["pipeline"]["feasibility"]["min_p_hold"]
     # What the run used is what it reports: planning done, no collision evidence, and the full
     # resolved configuration (the supervisor's settings included).
     assert result["planning"]["status"] == "done"
