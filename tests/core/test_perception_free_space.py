@@ -29,13 +29,14 @@ def test_seen_free_tells_points_in_front_of_a_surface_from_points_behind_or_besi
                   [0.0, 0.0, -0.02],    # behind it: hidden
                   [0.0, 0.0, 0.002],    # on it, within the depth margin
                   [0.2, 0.0, 0.0],      # beside it, where nothing of the object was seen
-                  [0.0, 0.0, 2.0]])     # behind the camera: never seen
+                  [0.0, 0.0, 2.0],      # behind the camera: never seen
+                  [3.0, 0.0, 0.999]])   # far off to the side, at the camera's height: seen
     free = seen_free(q, seen, CAMERA, radius=0.006, margin=0.004)
-    assert free.tolist() == [True, False, False, True, False]
+    assert free.tolist() == [True, False, False, True, False, True]
     # Another object between the camera and the point beside this one hides it.
     occluder = plane(0.01) + [0.14, 0.0, 0.3]  # on its line of sight, 0.7 of the way
     free = seen_free(q, seen, CAMERA, radius=0.006, margin=0.004, occluders=occluder)
-    assert free.tolist() == [True, False, False, False, False]
+    assert free.tolist() == [True, False, False, False, False, True]
     # A zero radius carves nothing.
     assert not seen_free(q, seen, CAMERA, radius=0.0, margin=0.004).any()
 

@@ -196,28 +196,31 @@ def seen_free(q: np.ndarray, p_seen: np.ndarray, p_C: np.ndarray, *, radius: flo
 
     ij_p, r_p, ok_p = image(P)
     ij_q, r_q, ok_q = image(q - p_C)
-    both = np.vstack([ij_p[ok_p], ij_q[ok_q]])
-    if not len(both):
-        return free
+    seen_ij = [ij_p[ok_p]]
+    if occluders is not None and len(occluders):
+        ij_o, r_o, ok_o = image(np.asarray(occluders, float).reshape(-1, 3) - p_C)
+        seen_ij.append(ij_o[ok_o])
+    # The image spans what was observed (the object and the others): a point beyond it is in
+    # front of the table the camera saw there, whatever its depth.
+    both = np.vstack(seen_ij)
     lo = both.min(axis=0) - 2
     shape = both.max(axis=0) - lo + 3
+    k_q = ij_q - lo
+    inside = ok_q & np.all((k_q >= 0) & (k_q < shape), axis=1)
+    k_q = tuple(k_q[inside].T)
 
     def nearest(ij: np.ndarray, r: np.ndarray) -> np.ndarray:
         """Each pixel's nearest range among the points (ij, r) within 2 pixels (inf: none)."""
-        k = ij - lo
-        on = np.all((k >= 0) & (k < shape), axis=1)
         buffer = np.full(tuple(shape), np.inf)
-        np.minimum.at(buffer, tuple(k[on].T), r[on])
+        np.minimum.at(buffer, tuple((ij - lo).T), r)
         return minimum_filter(buffer, size=5, mode="constant", cval=np.inf)
 
-    k_q = tuple((ij_q[ok_q] - lo).T)
     seen = np.full(len(q), np.inf)
-    seen[ok_q] = nearest(ij_p[ok_p], r_p[ok_p])[k_q]
+    seen[inside] = nearest(ij_p[ok_p], r_p[ok_p])[k_q]
     free = ok_q & (seen > r_q + margin)
-    if occluders is not None and len(occluders) and free.any():
-        ij_o, r_o, ok_o = image(np.asarray(occluders, float).reshape(-1, 3) - p_C)
+    if len(seen_ij) > 1 and free.any():
         in_front = np.full(len(q), np.inf)
-        in_front[ok_q] = nearest(ij_o[ok_o], r_o[ok_o])[k_q]
+        in_front[inside] = nearest(ij_o[ok_o], r_o[ok_o])[k_q]
         free &= ~(in_front < r_q)  # another object between the camera and q hides q
     return free
 
