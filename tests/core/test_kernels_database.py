@@ -55,11 +55,9 @@ def test_shipped_database_is_built_from_the_current_library(database):
 
 @pytest.mark.parametrize("obj_id", ["cup_02", "hammer_03", "bottle_01"])
 def test_fresh_sampling_of_a_library_object_finds_its_own_category(database, obj_id):
-    # A new sampling of an object in the database, compared as ground-truth samplings are: its
-    # own graphs are among the nearest (the nearest may be a sibling of its category), and the
-    # argmax is its category.
-    # Among the database's ground-truth samplings, its own are among the nearest n = 10 (coarse
-    # bins: siblings of a category hash alike, so they can come first).
+    # A new sampling of an object in the database, compared as ground-truth samplings are. Among
+    # the database's ground-truth samplings its own are among the nearest n = 10 (coarse bins:
+    # siblings of a category hash alike, so they can come first).
     category = load_library()[obj_id].category
     cloud = sample_object(load_library()[obj_id], rng=np.random.default_rng(99))
     entries, t = database.choice("ground_truth")

@@ -44,6 +44,7 @@ from scipy.ndimage import minimum_filter
 
 from tg_drake.errors import PerceptionError
 from tg_drake.perception.config import CompletionConfig
+from tg_drake.perception.geometry import frame_from_z
 
 # Normals within acos(0.5) = 60° of an axis estimate are on end faces, not the side wall.
 SIDE_WALL_COSINE = 0.5
@@ -180,11 +181,8 @@ def seen_free(q: np.ndarray, p_seen: np.ndarray, p_C: np.ndarray, *, radius: flo
     if not len(q) or not len(p_seen) or radius <= 0:
         return free
     P = p_seen - p_C
-    w = P.mean(axis=0)
-    w /= np.linalg.norm(w)
-    u = np.cross(w, [0.0, 0.0, 1.0] if abs(w[2]) < 0.9 else [1.0, 0.0, 0.0])
-    u /= np.linalg.norm(u)
-    v = np.cross(w, u)
+    ahead = P.mean(axis=0)  # the image's axis; its rows level with the table
+    u, v, w = frame_from_z(ahead, np.cross(ahead, [0.0, 0.0, 1.0])).T
     pixel = 0.5 * radius / float(np.linalg.norm(P, axis=1).mean())
 
     def image(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -194,15 +192,17 @@ def seen_free(q: np.ndarray, p_seen: np.ndarray, p_C: np.ndarray, *, radius: flo
         ij = np.floor(np.column_stack([x @ u, x @ v]) / (safe[:, None] * pixel)).astype(np.int64)
         return ij, np.linalg.norm(x, axis=1), ok
 
-    ij_p, r_p, ok_p = image(P)
+    def visible(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        ij, r, ok = image(x)
+        return ij[ok], r[ok]
+
+    ij_p, r_p = visible(P)
     ij_q, r_q, ok_q = image(q - p_C)
-    seen_ij = [ij_p[ok_p]]
-    if occluders is not None and len(occluders):
-        ij_o, r_o, ok_o = image(np.asarray(occluders, float).reshape(-1, 3) - p_C)
-        seen_ij.append(ij_o[ok_o])
+    others = (None if occluders is None or not len(occluders)
+              else visible(np.asarray(occluders, float).reshape(-1, 3) - p_C))
     # The image spans what was observed (the object and the others): a point beyond it is in
     # front of the table the camera saw there, whatever its depth.
-    both = np.vstack(seen_ij)
+    both = ij_p if others is None else np.vstack([ij_p, others[0]])
     lo = both.min(axis=0) - 2
     shape = both.max(axis=0) - lo + 3
     k_q = ij_q - lo
@@ -216,11 +216,11 @@ def seen_free(q: np.ndarray, p_seen: np.ndarray, p_C: np.ndarray, *, radius: flo
         return minimum_filter(buffer, size=5, mode="constant", cval=np.inf)
 
     seen = np.full(len(q), np.inf)
-    seen[inside] = nearest(ij_p[ok_p], r_p[ok_p])[k_q]
+    seen[inside] = nearest(ij_p, r_p)[k_q]
     free = ok_q & (seen > r_q + margin)
-    if len(seen_ij) > 1 and free.any():
+    if others is not None and free.any():
         in_front = np.full(len(q), np.inf)
-        in_front[inside] = nearest(ij_o[ok_o], r_o[ok_o])[k_q]
+        in_front[inside] = nearest(*others)[k_q]
         free &= ~(in_front < r_q)  # another object between the camera and q hides q
     return free
 

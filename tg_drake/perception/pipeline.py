@@ -117,7 +117,10 @@ def describe_scene(depth: np.ndarray, intrinsics: Intrinsics, X_WC: np.ndarray,
     cfg = cfg or PerceptionConfig()
     seg = segment_depth(depth, intrinsics, X_WC, cfg.segmentation)
     p_TC = transform(inverse(seg.X_WT), np.asarray(X_WC, float)[:3, 3][None])[0]
-    objects = [describe_object(q, seg.X_WT, p_TC, cfg, occluders_T=np.concatenate(
-        [o for j, o in enumerate(seg.objects_T) if j != i] or [np.zeros((0, 3))]))
-        for i, q in enumerate(seg.objects_T)]
+    # Every object's points, each object's own span: the others of an object are the rest.
+    every = np.concatenate([np.zeros((0, 3)), *seg.objects_T])
+    ends = np.cumsum([len(q) for q in seg.objects_T])
+    objects = [describe_object(q, seg.X_WT, p_TC, cfg,
+                               occluders_T=np.delete(every, np.s_[end - len(q):end], axis=0))
+               for q, end in zip(seg.objects_T, ends, strict=True)]
     return SceneDescription(objects=objects, X_WT=seg.X_WT)
