@@ -52,6 +52,7 @@ from tg_drake.planning.handover import (
     mount_pose,
 )
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS, WSG_MAX_OPENING, WSG_OPEN_POSITIONS
+from tg_drake.robot_plants import couple_fingers
 from tg_drake.scenario import WsgPdDriver
 from tg_drake.systems.plan_messages import PlanState, PlanStatus
 
@@ -85,6 +86,7 @@ def add_receiver(plant: MultibodyPlant, parser, scenario) -> ModelInstanceIndex:
         default_joint_positions={n: [q] for n, q in zip(WSG_FINGER_JOINTS, WSG_OPEN_POSITIONS,
                                                         strict=True)}))]), parser)
     instance = added[0].model_instance
+    couple_fingers(plant, instance)  # the same gripper: one drive moves both fingers
     M = SpatialInertia.SolidSphereWithMass(MOUNT_LINK_MASS, MOUNT_LINK_RADIUS)
     links = [plant.world_body()] + [plant.AddRigidBody(f"{RECEIVER}_mount_{n}", instance, M)
                                     for n in MOUNT_JOINTS[:-1]]

@@ -20,6 +20,7 @@ from pydrake.multibody.parsing import (
     ProcessModelDirectives,
 )
 from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import ModelInstanceIndex
 
 from tg_drake.errors import ModelError, ScenarioError
 from tg_drake.models import make_parser
@@ -85,3 +86,13 @@ def add_scenario_models(plant: MultibodyPlant, scenario,
     except RuntimeError as e:
         raise ModelError(f"could not load the models {', '.join(model_instance_names)} of the "
                          f"scenario's directives: {e}") from None
+
+
+def couple_fingers(plant: MultibodyPlant, instance: ModelInstanceIndex) -> None:
+    """The WSG 50's two fingers move as one mechanism, symmetric about the gripper's centre (one
+    drive for both jaws): a coupler constraint q_left = −q_right between the finger joints
+    (before Finalize). Without it each finger's PD pushes on its own, and a load along the
+    closing axis moves a held object, fingers and all (a mug held end to end drifted 13 mm during
+    its lift, to one finger's stroke limit)."""
+    left, right = (plant.GetJointByName(name, instance) for name in WSG_FINGER_JOINTS)
+    plant.AddCouplerConstraint(left, right, -1.0)

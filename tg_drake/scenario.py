@@ -117,6 +117,8 @@ class WsgPdDriver:
     kd: float = 50.0  # [N·s/m]
     force_limit: float = WSG_FORCE_LIMIT  # [N] per finger: the WSG 50 drive's limit; at
     # 40 N a 0.55 kg hammer held by its handle turned out of the pads while carried.
+    coupled: bool = True  # the fingers move symmetrically, as the gripper's one drive moves
+    # them (a coupler constraint, `tg_drake.robot_plants.couple_fingers`).
 
 
 @dataclass

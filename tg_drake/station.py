@@ -94,7 +94,7 @@ from tg_drake.models import make_parser
 from tg_drake.objects import get_object, mesh, obj_text
 from tg_drake.receiver import RECEIVER, add_receiver, connect_receiver, receiver_of
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
-from tg_drake.robot_plants import add_scenario_models
+from tg_drake.robot_plants import add_scenario_models, couple_fingers
 from tg_drake.scenario import (
     InverseDynamicsDriver,
     JointPdDriver,
@@ -533,6 +533,8 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
         if isinstance(driver, WsgPdDriver):
             for actuator in _actuators(plant, instance):
                 actuator.set_effort_limit(driver.force_limit)
+            if driver.coupled:
+                couple_fingers(plant, instance)
         if isinstance(driver, JointPdDriver) and not driver.gravity_compensation:
             continue
         plant.set_gravity_enabled(instance, False)

@@ -169,3 +169,15 @@ def test_a_batch_records_the_object_mass_it_ran_with(tmp_path):
     own, = run_grasp_batch({**payload, "config": {}})
     assert light["object_mass"] == 0.1 and "object_mass" not in own
     assert light["status"] == own["status"] == "ok" and light["index"] == 0
+
+
+def test_the_episode_fingers_close_as_one_drive(world):
+    # 15 mm off the cylinder's axis along the closing axis: one pad meets it 30 mm before the
+    # other. Coupled (the WSG 50's one drive, as in the station), the pads stay symmetric about the
+    # gripper's centre whatever they touch first.
+    result = world.run(X_WO, top_down([0.015, 0, HEIGHT + 0.01]))
+    assert result["status"] == "ok"
+    plant_context = world.plant.GetMyContextFromRoot(world.context)
+    left, right = (f.get_translation(plant_context) for f in world.fingers)
+    assert left < -0.02 and right > 0.02  # closed on the 66 mm cylinder, not on air
+    assert abs(left + right) < 0.0005

@@ -56,6 +56,7 @@ from tg_drake.errors import SimulationError
 from tg_drake.grasping.dgi import MAX_OPENING
 from tg_drake.outcome import HandGeometries, hand_contact, touches_table
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
+from tg_drake.robot_plants import couple_fingers
 
 TABLE_TOP_Z = 0.0  # the table's top surface in the world [m] (table_top frame welded at W).
 FINGER_JOINTS = WSG_FINGER_JOINTS
@@ -79,6 +80,8 @@ class EpisodeConfig:
     grip_force: float = 60.0  # set-point force of each finger [N] (the effort limit is 80 N).
     finger_kp: float = 2000.0  # finger PD gains [N/m], [N·s/m] (as the station's WSG driver).
     finger_kd: float = 50.0
+    coupled: bool = True  # the fingers move as one drive moves them (as the station's WSG:
+    # `tg_drake.robot_plants.couple_fingers`)
     carrier_kp_translation: float = 2.0e5  # [N/m]: 0.06 mm sag under a 1.2 kg object's weight.
     carrier_kd_translation: float = 2.0e3  # [N·s/m]: well damped for the 1.1 kg gripper.
     carrier_kp_rotation: float = 2.0e3  # [N·m/rad]
@@ -230,6 +233,8 @@ class GraspWorld:
         for name in FINGER_JOINTS:
             plant.GetJointActuatorByName(name, wsg).set_controller_gains(
                 PdControllerGains(p=config.finger_kp, d=config.finger_kd))
+        if config.coupled:
+            couple_fingers(plant, wsg)
         plant.set_gravity_enabled(wsg, False)
         plant.Finalize()
 
