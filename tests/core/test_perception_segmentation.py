@@ -310,3 +310,47 @@ def test_a_flat_blade_beside_a_raised_handle_keeps_its_blade(seed, blade_mm):
     (p,) = _d415_objects([handle, blade], seed)
     assert p[:, 1].min() < -0.105 and p[:, 1].max() > 0.105  # handle end to blade tip
     assert np.abs(p[:, 0]).max() < 0.015 + 0.008
+
+
+def _rod_cut(band_m: float, fill: str):
+    """A 2.5 × 30 × 2.5 cm rod lying on the table along y (across the camera's view), with the
+    pixels of its middle `band_m` [m] either lost (depth 0, as a sensor's dropout) or showing
+    the table under it."""
+    rod = on_table(S.box((0.025, 0.3, 0.025)), 0.0, 0.0)
+    bare = S.render_depth([table()], K, X_WC)
+    depth = S.render_depth([table(), rod], K, X_WC)
+    from tg_drake.perception.geometry import depth_to_points
+    p_W, px = depth_to_points(depth, K, X_WC)
+    on_rod = p_W[:, 2] > TABLE_Z + 0.002
+    cut = px[on_rod & (np.abs(p_W[:, 1]) < band_m / 2)]
+    depth = depth.copy()
+    depth[cut[:, 0], cut[:, 1]] = 0.0 if fill == "lost" else bare[cut[:, 0], cut[:, 1]]
+    return depth
+
+
+def _count(depth, bridge_px):
+    cfg = SegmentationConfig(lost_bridge_px=bridge_px)
+    return len(segment_depth(depth, K, X_WC, cfg).objects_T)
+
+
+def test_a_part_cut_off_by_lost_pixels_joins_its_object():
+    # 2 cm of the rod lost (11 px here): two pieces apart in the image by lost pixels only.
+    depth = _rod_cut(0.02, "lost")
+    assert _count(depth, 0) == 2
+    assert _count(depth, 8) == 1  # each piece grown 8 px into the lost pixels: they meet
+
+
+def test_table_seen_between_two_pieces_keeps_them_apart():
+    # The same cut, but the camera sees the table through it: two objects whatever the bridge.
+    depth = _rod_cut(0.02, "table")
+    assert _count(depth, 8) == 2
+    assert _count(depth, 40) == 2
+
+
+def test_pieces_farther_apart_than_the_bridge_stay_apart():
+    # 12 cm lost (about 67 px): more lost pixels than an 8 px bridge spans; with one that spans
+    # them (40 px from each side), the pieces are still farther apart in space than
+    # merge_max_gap (0.10 m).
+    depth = _rod_cut(0.12, "lost")
+    assert _count(depth, 8) == 2
+    assert _count(depth, 40) == 2

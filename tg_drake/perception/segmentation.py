@@ -261,8 +261,13 @@ def _merge_occluded(labels_px: np.ndarray, p_px: np.ndarray, rows: np.ndarray, c
                                  - points[dr:dr + height, 2 + dc:2 + dc + width][m], axis=1)
             close = gap <= max_gap
             pairs.append(np.column_stack([a[m][close], b[m][close]]))
+    return _joined(n, np.unique(np.concatenate(pairs), axis=0) if pairs else [])
+
+
+def _joined(n: int, pairs) -> np.ndarray:
+    """Cluster id → the smallest id of its group, the groups joined by `pairs` (i, j)."""
     parent = np.arange(n)
-    for i, j in np.unique(np.concatenate(pairs), axis=0) if pairs else []:
+    for i, j in pairs:
         ri, rj = i, j
         while parent[ri] != ri:
             ri = parent[ri]
@@ -272,6 +277,43 @@ def _merge_occluded(labels_px: np.ndarray, p_px: np.ndarray, rows: np.ndarray, c
     for i in range(n):  # flatten (parents have smaller ids)
         parent[i] = parent[parent[i]]
     return parent
+
+
+def _merge_through_lost(labels_px: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+                        valid: np.ndarray, q: np.ndarray, labels_q: np.ndarray, n: int,
+                        bridge_px: int, max_gap: float) -> np.ndarray:
+    """Cluster id → merged cluster id, joining clusters that meet in the image when each grows,
+    one pixel per step for `bridge_px` steps, into the pixels the sensor lost (`valid`: (H, W)
+    True where the frame has a depth), and whose nearest points (q (M, 3) voxel points with
+    their cluster `labels_q`) are at most `max_gap` [m] apart. A pixel with a depth (the table,
+    another object) stops the growth: what the camera saw between two clusters keeps them
+    apart."""
+    height, width = valid.shape
+    image = np.full((height + 2, width + 2), -1)
+    image[rows + 1, cols + 1] = labels_px
+    lost = np.zeros((height + 2, width + 2), bool)
+    lost[1:-1, 1:-1] = ~valid
+    lost[rows + 1, cols + 1] = False
+    shifts = ((0, 1), (0, -1), (1, 0), (-1, 0))
+    for _ in range(bridge_px):
+        grown = image.copy()
+        for dr, dc in shifts:
+            src = np.roll(image, (dr, dc), axis=(0, 1))
+            take = (grown < 0) & lost & (src >= 0)
+            grown[take] = src[take]
+        if np.array_equal(grown, image):
+            break
+        image = grown
+    pairs = set()
+    for dr, dc in ((0, 1), (1, -1), (1, 0), (1, 1)):
+        a = image[1:-1, 1:-1]
+        b = np.roll(image, (-dr, -dc), axis=(0, 1))[1:-1, 1:-1]
+        m = (a >= 0) & (b >= 0) & (a != b)
+        pairs.update(map(tuple, np.unique(np.sort(np.column_stack([a[m], b[m]]), axis=1),
+                                          axis=0).tolist()))
+    near = [(i, j) for i, j in sorted(pairs)
+            if cKDTree(q[labels_q == i]).query(q[labels_q == j], k=1)[0].min() <= max_gap]
+    return _joined(n, near)
 
 
 def fit_circle(xy: np.ndarray) -> tuple[np.ndarray, float, float]:
@@ -341,8 +383,8 @@ def _merge_shared_rims(q: np.ndarray, labels: np.ndarray, n: int, cfg: Segmentat
 
 
 def _clusters(idx: np.ndarray, p_T: np.ndarray, pixels: np.ndarray,
-              image_size: tuple[int, int], cfg: SegmentationConfig
-              ) -> list[tuple[np.ndarray, bool, np.ndarray]]:
+              image_size: tuple[int, int], cfg: SegmentationConfig,
+              valid: np.ndarray | None = None) -> list[tuple[np.ndarray, bool, np.ndarray]]:
     """The object clusters of the points `idx` (indices into p_T (N, 3) [m] and their image
     pixels (N, 2)): per cluster (its voxel-averaged points, whether it touches the image border,
     the indices of its points)."""
@@ -365,6 +407,12 @@ def _clusters(idx: np.ndarray, p_T: np.ndarray, pixels: np.ndarray,
         labels = np.where(labels >= 0, merged[labels], -1)
         rims = _merge_shared_rims(q, labels, n_clusters, cfg)
         labels = np.where(labels >= 0, rims[np.maximum(labels, 0)], -1)
+        if cfg.lost_bridge_px > 0 and valid is not None:
+            keep_px = labels[voxel] >= 0
+            lost = _merge_through_lost(labels[voxel][keep_px], r[keep_px], c[keep_px], valid,
+                                       q[labels >= 0], labels[labels >= 0], n_clusters,
+                                       cfg.lost_bridge_px, cfg.merge_max_gap)
+            labels = np.where(labels >= 0, lost[np.maximum(labels, 0)], -1)
     order = np.argsort(labels, kind="stable")
     bounds = np.searchsorted(labels[order], np.arange(n_clusters + 1))
     out = []
@@ -418,7 +466,9 @@ def segment_cloud(p_W: np.ndarray, pixels: np.ndarray, image_size: tuple[int, in
     p_T_all = transform(X_TW, p_W)
     inside = np.all(p_T_all[:, :2] >= lo, axis=1) & np.all(p_T_all[:, :2] <= hi, axis=1)
     regular = inside & (height > cfg.min_object_height) & (height < cfg.max_object_height)
-    found = _clusters(np.flatnonzero(regular), p_T_all, pixels, image_size, cfg)
+    valid = np.zeros((image_size[1], image_size[0]), bool)  # pixels with a depth
+    valid[pixels[:, 0], pixels[:, 1]] = True
+    found = _clusters(np.flatnonzero(regular), p_T_all, pixels, image_size, cfg, valid)
     range_all = np.linalg.norm(p_W - p_WC, axis=1)
     on_plane = np.abs(height) < cfg.plane_distance
     thin = inside & raised_cells(p_T_all, height, range_all, on_plane, cfg)
@@ -437,7 +487,7 @@ def segment_cloud(p_W: np.ndarray, pixels: np.ndarray, image_size: tuple[int, in
             d, _ = cKDTree(p_T_all[taken]).query(p_T_all[rest],
                                                  distance_upper_bound=cfg.cluster_eps)
             rest = rest[~np.isfinite(d)]
-        found += [f for f in _clusters(rest, p_T_all, pixels, image_size, cfg)
+        found += [f for f in _clusters(rest, p_T_all, pixels, image_size, cfg, valid)
                   if (thin | flat)[f[2]].any()]
     if found and cfg.foot_noise_sigmas > 0:
         a = table_noise_scale(height, range_all, on_plane)
