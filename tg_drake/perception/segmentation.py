@@ -384,10 +384,10 @@ def _merge_shared_rims(q: np.ndarray, labels: np.ndarray, n: int, cfg: Segmentat
 
 def _clusters(idx: np.ndarray, p_T: np.ndarray, pixels: np.ndarray,
               image_size: tuple[int, int], cfg: SegmentationConfig,
-              valid: np.ndarray | None = None) -> list[tuple[np.ndarray, bool, np.ndarray]]:
+              valid: np.ndarray) -> list[tuple[np.ndarray, bool, np.ndarray]]:
     """The object clusters of the points `idx` (indices into p_T (N, 3) [m] and their image
-    pixels (N, 2)): per cluster (its voxel-averaged points, whether it touches the image border,
-    the indices of its points)."""
+    pixels (N, 2); `valid` (H, W): the frame's pixels with a depth): per cluster (its
+    voxel-averaged points, whether it touches the image border, the indices of its points)."""
     if len(idx) < cfg.min_cluster_points:
         return []
     p = p_T[idx]
@@ -407,7 +407,7 @@ def _clusters(idx: np.ndarray, p_T: np.ndarray, pixels: np.ndarray,
         labels = np.where(labels >= 0, merged[labels], -1)
         rims = _merge_shared_rims(q, labels, n_clusters, cfg)
         labels = np.where(labels >= 0, rims[np.maximum(labels, 0)], -1)
-        if cfg.lost_bridge_px > 0 and valid is not None:
+        if cfg.lost_bridge_px > 0:
             keep_px = labels[voxel] >= 0
             lost = _merge_through_lost(labels[voxel][keep_px], r[keep_px], c[keep_px], valid,
                                        q[labels >= 0], labels[labels >= 0], n_clusters,
