@@ -9,7 +9,8 @@ joints from the world — prismatic along the world's x, y, z, then revolute abo
 (`tg_drake.planning.handover.mount_pose`: X_WR = translation · Rz(yaw) · Ry(pitch) · Rx(roll)) —
 each driven by the plant's own PD controller like the station's other actuators (implicit in
 SAP), gravity off for the instance (compensated, as the robot's gripper). Its fingers are driven
-like the robot's WSG: the scenario's `model_drivers.wsg` gains and force limit (`WsgPdDriver`).
+like the robot's WSG: the scenario's `model_drivers.wsg` gains, force limit and coupling
+(`WsgPdDriver`).
 It starts where it waits (`Handover.X_WR_wait`), fingers open.
 
 Station ports it adds: inputs ``receiver.mount`` (12: the mount's desired q, v), and
@@ -86,7 +87,6 @@ def add_receiver(plant: MultibodyPlant, parser, scenario) -> ModelInstanceIndex:
         default_joint_positions={n: [q] for n, q in zip(WSG_FINGER_JOINTS, WSG_OPEN_POSITIONS,
                                                         strict=True)}))]), parser)
     instance = added[0].model_instance
-    couple_fingers(plant, instance)  # the same gripper: one drive moves both fingers
     M = SpatialInertia.SolidSphereWithMass(MOUNT_LINK_MASS, MOUNT_LINK_RADIUS)
     links = [plant.world_body()] + [plant.AddRigidBody(f"{RECEIVER}_mount_{n}", instance, M)
                                     for n in MOUNT_JOINTS[:-1]]
@@ -112,6 +112,8 @@ def add_receiver(plant: MultibodyPlant, parser, scenario) -> ModelInstanceIndex:
         actuator = plant.GetJointActuatorByName(name, instance)
         actuator.set_controller_gains(PdControllerGains(p=driver.kp, d=driver.kd))
         actuator.set_effort_limit(driver.force_limit)
+    if driver.coupled:
+        couple_fingers(plant, instance)
     plant.set_gravity_enabled(instance, False)
     return instance
 

@@ -184,8 +184,7 @@ def main(argv=None) -> int:
             current, current_file = load_closed_end(args.out)
         except (OSError, ValueError, KeyError, TypeError):
             current = None  # no model there: the fit
-        model, which = better_closed_end(fitted, current, ends)
-        if which == "current":
+        if better_closed_end(fitted, current, ends)[1] == "current":
             kept, earlier = current, current_file
             chosen = f"kept from {args.out} (higher training accuracy than the fit)"
     model = kept if kept is not None else fitted

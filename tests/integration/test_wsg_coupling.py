@@ -1,6 +1,9 @@
 """The WSG 50's fingers move as one mechanism: a load along the closing axis does not move a
 held object, fingers and all, along that axis."""
 
+import dataclasses
+from pathlib import Path
+
 import numpy as np
 from pydrake.geometry import Box
 from pydrake.math import RigidTransform, RollPitchYaw
@@ -17,7 +20,8 @@ from pydrake.systems.primitives import ConstantVectorSource
 from tg_drake.models import make_parser
 from tg_drake.robot import WSG_FINGER_JOINTS, WSG_FORCE_LIMIT, WSG_GRASP_POINT_G
 from tg_drake.robot_plants import couple_fingers
-from tg_drake.scenario import WsgPdDriver
+from tg_drake.scenario import WsgPdDriver, load_scenario
+from tg_drake.station import make_station
 
 MASS = 1.5  # [kg] its weight (15 N) pulls along the closing axis, below both fingers' 80 N
 # [m] the box, its width along the closing axis: wide enough that the fingers, commanded shut,
@@ -70,3 +74,15 @@ def test_a_load_along_the_closing_axis_does_not_slide_the_coupled_fingers():
     # Each finger on its own PD: the weight moves the pair, object and all (measured 5.8 mm; the
     # lower finger's PD at its force limit gives way).
     assert finger_offset(coupled=False) > 0.003
+
+
+def test_the_robots_and_the_receivers_fingers_follow_the_scenarios_driver():
+    # The default scenario (a pass: the station has a receiver): both grippers coupled, one
+    # constraint each; the scenario's driver uncoupled: neither is.
+    scenario = load_scenario(Path(__file__).resolve().parents[2] / "scenarios" / "default.yaml")
+    _, station = make_station(scenario)
+    assert station.plant.num_constraints() == 2
+    drivers = dict(scenario.model_drivers)
+    drivers["wsg"] = dataclasses.replace(drivers["wsg"], coupled=False)
+    _, station = make_station(dataclasses.replace(scenario, model_drivers=drivers))
+    assert station.plant.num_constraints() == 0

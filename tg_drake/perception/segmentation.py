@@ -407,10 +407,10 @@ def _clusters(idx: np.ndarray, p_T: np.ndarray, pixels: np.ndarray,
         labels = np.where(labels >= 0, merged[labels], -1)
         rims = _merge_shared_rims(q, labels, n_clusters, cfg)
         labels = np.where(labels >= 0, rims[np.maximum(labels, 0)], -1)
-        if cfg.lost_bridge_px > 0:
-            keep_px = labels[voxel] >= 0
+        if cfg.lost_bridge_px > 0:  # (the merges keep which voxels are noise: keep_px holds)
+            kept = labels >= 0
             lost = _merge_through_lost(labels[voxel][keep_px], r[keep_px], c[keep_px], valid,
-                                       q[labels >= 0], labels[labels >= 0], n_clusters,
+                                       q[kept], labels[kept], n_clusters,
                                        cfg.lost_bridge_px, cfg.merge_max_gap)
             labels = np.where(labels >= 0, lost[np.maximum(labels, 0)], -1)
     order = np.argsort(labels, kind="stable")
