@@ -301,6 +301,11 @@ class SupervisorConfig:
     max_retries: int = 0  # after a missed grasp or a failed lift: look again (every plan then
     # ends with the arm back at its start) and plan again from the new scene, at most this many
     # times (0: off, the run ends missed / slipped)
+    max_reseats: int = 1  # at the place, when the object still touches a pad once the pads have
+    # opened, the plan re-seats it (closes on it where it stands and opens again) before the
+    # retreat, at most this many times per plan (0: off, the retreat goes ahead)
+    release_check_delay: float = 0.05  # [s] after the pads are commanded open at the place, the
+    # touch check (within PlannerConfig.release_dwell, less the planner's period)
 
     def validate(self, where: str = "pipeline.supervisor") -> None:
         checks = (("min_grasp_probability", 0.0 <= self.min_grasp_probability <= 1.0, "in [0, 1]"),
@@ -310,7 +315,9 @@ class SupervisorConfig:
                   ("period", self.period > 0.0, "> 0 s"),
                   ("min_rise_ratio", 0.0 <= self.min_rise_ratio <= 1.0, "in [0, 1]"),
                   ("max_regrasps", self.max_regrasps >= 0, ">= 0"),
-                  ("max_retries", self.max_retries >= 0, ">= 0"))
+                  ("max_retries", self.max_retries >= 0, ">= 0"),
+                  ("max_reseats", self.max_reseats >= 0, ">= 0"),
+                  ("release_check_delay", self.release_check_delay >= 0.0, ">= 0 s"))
         for name, ok, allowed in checks:
             if not ok:
                 raise ScenarioError(f"must be {allowed}, got {getattr(self, name)}",

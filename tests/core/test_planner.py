@@ -21,6 +21,8 @@ from tg_drake.planning.planner import (
     carried_box,
     place_pose,
     plan_pick_and_place,
+    reseat_duration,
+    reseated,
 )
 from tg_drake.planning.regrasp import plan_task_leg
 from tg_drake.planning.trajectory import IIWA_VELOCITY_LIMITS
@@ -292,6 +294,45 @@ def test_plan_reaches_its_key_poses(planned):
     # At rest at the end, and held there afterwards.
     np.testing.assert_allclose(plan.v(plan.duration), 0.0, atol=1e-9)
     np.testing.assert_allclose(plan.q(plan.duration + 5.0), plan.q(plan.duration), atol=0)
+
+
+def test_the_pads_stand_open_at_the_place_before_the_retreat(planned):
+    plan, c = planned.plan, PlannerConfig()
+    assert plan.t_place_done - plan.t_opened == pytest.approx(c.release_dwell)
+    for t in np.linspace(plan.t_opened, plan.t_place_done, 5):
+        assert plan.width(t) == c.open_width
+        np.testing.assert_allclose(plan.v(t), 0.0, atol=1e-9)
+        np.testing.assert_allclose(plan.q(t), plan.q(plan.t_place_done), atol=1e-12)
+
+
+def test_a_reseat_closes_and_opens_the_pads_at_the_place_and_delays_the_retreat(planned):
+    plan, c = planned.plan, PlannerConfig()
+    t_at = plan.t_opened + 0.05
+    new = reseated(plan, t_at, c)
+    shift = new.duration - plan.duration
+    assert shift == pytest.approx(reseat_duration(c) + c.release_dwell - (plan.t_place_done - t_at))
+    assert new.t_opened == pytest.approx(t_at + reseat_duration(c))
+    assert new.t_place_done == pytest.approx(new.t_opened + c.release_dwell)
+    # Unchanged up to the re-seat; the arm holds its place posture through it.
+    for t in np.linspace(0.0, t_at, 40):
+        np.testing.assert_allclose(new.q(t), plan.q(t), atol=1e-12)
+        assert new.width(t) == pytest.approx(plan.width(t))
+    for t in np.linspace(t_at, new.t_place_done, 20):
+        np.testing.assert_allclose(new.q(t), plan.q(plan.t_place_done), atol=1e-12)
+        np.testing.assert_allclose(new.v(t), 0.0, atol=1e-9)
+    # The pads close on the object (the grasp's squeeze), then open again.
+    assert new.width(t_at + c.close_duration + c.squeeze_duration) == c.closed_width
+    assert new.width(new.t_opened) == c.open_width
+    # The retreat and everything after it, delayed.
+    for x in np.linspace(0.0, plan.duration - plan.t_place_done, 20):
+        np.testing.assert_allclose(new.q(new.t_place_done + x), plan.q(plan.t_place_done + x),
+                                   atol=1e-9)
+        np.testing.assert_allclose(new.v(new.t_place_done + x), plan.v(plan.t_place_done + x),
+                                   atol=1e-9)
+    retreat = dict((name, (a, b)) for name, a, b, _ in new.segments)["retreat"]
+    assert retreat[0] == pytest.approx(new.t_place_done)
+    with pytest.raises(ValueError, match="pads open at the place"):
+        reseated(plan, plan.t_place_done + 0.01, c)
 
 
 def test_trajectory_keeps_velocity_and_acceleration_limits(planned):

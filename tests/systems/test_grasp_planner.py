@@ -177,3 +177,32 @@ def test_unreachable_place_gives_up_without_blaming_the_part():
     assert (s.status, s.unreachable_parts, s.failed_part) == ("failed", (), None)
     assert s.picked_parts == ("top",)  # the supervisor's reason: unreachable, not would_not_hold
     assert "picked but not placed" in s.reason
+
+
+@pytest.mark.parametrize("late", [False, True])
+def test_a_reseat_request_while_the_pads_stand_open_delays_the_retreat(late):
+    """``plan_request.reseats`` one more than answered: at its next event, while the plan's pads
+    stand open at the place, the planner inserts a re-seat (the pads close and open again) and
+    follows the new plan; asked after that pause, it answers with the plan unchanged."""
+    planner = GraspPlanner(place_xy=(0.75, -0.25), start_time=START)
+    context = fixed_inputs(planner, SCENE, ranked([(TOP, "top")]))
+    planner.get_plan_request_input_port().FixValue(context, PlanRequest(attempt=1))
+    simulator = Simulator(planner, context)
+    simulator.Initialize()
+    simulator.AdvanceTo(START + 0.01)
+    plan = status(planner, context).plan
+    t_ask = START + (plan.t_place_done + 0.01 if late else plan.t_opened)
+    simulator.AdvanceTo(t_ask)
+    planner.get_plan_request_input_port().FixValue(context, PlanRequest(attempt=1, reseats=1))
+    simulator.AdvanceTo(t_ask + 0.06)  # one planning period
+    s = status(planner, context)
+    assert (s.status, s.attempt, s.reseats) == ("executing", 1, 1)
+    if late:
+        assert s.plan is plan
+        return
+    assert s.plan.duration > plan.duration and s.plan.t_opened > plan.t_place_done
+    c = PlannerConfig()
+    simulator.AdvanceTo(START + s.plan.t_opened - c.open_duration - c.squeeze_duration - 0.05)
+    assert planner.get_wsg_position_output_port().Eval(context)[0] == c.closed_width
+    np.testing.assert_allclose(desired(planner, context)[:7], plan.q(plan.t_place_done),
+                               atol=1e-12)

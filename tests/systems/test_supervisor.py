@@ -507,3 +507,43 @@ def test_a_place_whose_object_is_lost_during_the_carry_says_so(monkeypatch, t_po
     o = f.outcome
     assert (o.status, o.reason, o.final) == ("lifted", "slipped", True)
     assert o.detail.startswith("lost during the carry: not held as the descent to the place")
+
+
+@pytest.mark.parametrize("max_reseats", [1, 0])
+def test_an_object_still_touching_a_pad_once_they_opened_is_reseated_once(monkeypatch,
+                                                                          max_reseats):
+    """A place: held at the grasp, the lift's end and the descent; at the check after the pads
+    opened the object still touches the left pad: the supervisor asks the planner for a re-seat
+    (``plan_request.reseats``), waits for the plan that holds it, checks again at its later
+    opening (still touching: no second re-seat, max_reseats 1) and the outcome counts it. With
+    max_reseats 0 nothing is asked."""
+    touch = iter([(True, 40.0)] * 3 + [(True, 0.0)] * 2)
+    monkeypatch.setattr(supervisor_module, "hand_contact", lambda contacts, **k: HandContact(
+        0.02, *((True, True, 2, 40.0, 40.0) if (t := next(touch, (False, 0.0)))[1]
+                else (t[0], False, 1, 0.0, 0.0))))
+    monkeypatch.setattr(supervisor_module, "touches_table", lambda contacts, **k: True)
+    monkeypatch.setattr(supervisor_module, "placed",
+                        lambda *a, **k: (True, "1.0 cm from the target, tilted 0°"))
+    f = Fixed(config=SupervisorConfig(planning_start=0.0, period=0.01, planning_timeout=0.5,
+                                      max_reseats=max_reseats, release_check_delay=0.02))
+    f.advance(0.001)
+    plan = SimpleNamespace(regrasp=False, t_grasp_closed=0.1, t_lift_done=0.2, t_descend=0.3,
+                           t_opened=0.4, t_place_done=0.45, duration=0.6, t_pour=None,
+                           R_turn=None, X_WO_place=np.eye(4))
+    f.plan(PlanStatus(PlanState.executing, attempt=1, part="middle", t_plan=0.0, plan=plan))
+    f.advance(0.415)
+    assert f.request.reseats == 0  # the check comes 0.02 s after the pads opened
+    f.advance(0.445)
+    assert f.request.reseats == max_reseats
+    if max_reseats:
+        later = SimpleNamespace(**{**vars(plan), "t_opened": 0.7, "t_place_done": 0.75,
+                                   "duration": 0.9})
+        f.advance(0.5)  # the planner has not answered: the old plan's end is not judged
+        assert not f.outcome.final
+        f.plan(PlanStatus(PlanState.executing, attempt=1, part="middle", t_plan=0.0,
+                          plan=later, reseats=1))
+        f.advance(0.8)
+        assert not f.outcome.final and f.request.reseats == 1  # checked again: no second one
+    f.advance(1.0)
+    o = f.outcome
+    assert (o.status, o.reseats, o.as_dict()["reseats"]) == ("placed", max_reseats, max_reseats)

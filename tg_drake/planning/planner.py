@@ -45,12 +45,13 @@ held object is its bounding box welded to the gripper.
 """
 
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.math import RigidTransform
-from pydrake.trajectories import CompositeTrajectory, PiecewisePolynomial
+from pydrake.trajectories import BsplineTrajectory, CompositeTrajectory, PiecewisePolynomial
 
 from tg_drake.errors import ScenarioError
 from tg_drake.logic.receive import receiver_parts
@@ -114,6 +115,9 @@ class PlannerConfig:
     close_duration: float = 0.8  # [s] opening → closed command ramp (scripted.py's timing).
     settle_duration: float = 0.4  # [s] hold after closing, before lifting.
     open_duration: float = 0.5  # [s] closed → open at release.
+    release_dwell: float = 0.15  # [s] the pads held open at the place before the retreat: the
+    # supervisor looks there whether the object came free of them, and may have the plan
+    # re-seat it (`reseated`; SupervisorConfig.max_reseats) before the retreat begins.
     min_distance: float = 0.01  # [m] clearance of free and carrying motions.
     contact_min_distance: float = 0.003  # [m] clearance near the target (approach, grasp,
     # lift, descent, place, retreat), where the fingers straddle the object.
@@ -184,6 +188,8 @@ class Plan:
     # HandoverMotion, its grasp and part), in plan time; None: no hand-over
     t_descend: float | None = None  # [s] the descent to the place pose begins (the carry and
     # any pour are over); None: not recorded
+    t_opened: float | None = None  # [s] the pads are commanded fully open at the place; the arm
+    # holds still until `t_place_done` (PlannerConfig.release_dwell); None: no such pause (a pass)
     regrasp: bool = False  # the plan ends with the object placed in an intermediate resting pose
     # and the arm back at its start (out of the camera's view): a place-and-regrasp's first leg
     # (tg_drake.planning.regrasp); the supervisor looks again and plans the next leg
@@ -225,6 +231,66 @@ class PlanResult:
     ik_solves: int = 0  # inverse-kinematics solver calls of the request (`plan_task_leg`)
     out_of_budget: bool = False  # the request's budget (PlannerConfig.max_ik_solves) ran out
     # before a plan was found (`plan_task_leg`)
+
+
+def reseat_duration(config: PlannerConfig) -> float:
+    """[s] A re-seat: the pads close on the object where it stands, squeeze, settle, let go and
+    open again (the grasp's own timing)."""
+    return (config.close_duration + 2 * config.squeeze_duration + config.settle_duration
+            + config.open_duration)
+
+
+def reseated(plan: Plan, t_at: float, config: PlannerConfig) -> Plan:
+    """`plan` with a re-seat inserted at plan time `t_at`, while the pads stand open at the
+    place (`plan.t_opened` ≤ t_at < `plan.t_place_done`): the arm holds its place posture while
+    the pads close on the object where it now stands and open again, holds
+    `config.release_dwell` more, then retreats as planned. An object that settled against one
+    pad as the pads opened (a lying cup rolling onto the pad whose tip is under its rim) is
+    pushed back between them, and let go from rest. Everything after the place is delayed."""
+    if plan.t_opened is None or not plan.t_opened <= t_at < plan.t_place_done:
+        raise ValueError(f"a re-seat needs the pads open at the place: t_at = {t_at} s outside "
+                         f"[{plan.t_opened}, {plan.t_place_done}) s")
+    t_opened = t_at + reseat_duration(config)
+    t_done = t_opened + config.release_dwell
+    shift = t_done - plan.t_place_done
+    q_place = plan.q(t_at)
+    pieces = []
+    for k in range(plan.q_traj.get_number_of_segments()):
+        piece = plan.q_traj.segment(k)
+        start, end = piece.start_time(), piece.end_time()
+        if end <= t_at + 1e-9:
+            pieces.append(piece)
+        elif start <= t_at:  # the hold at the place, stretched to the new end of the pause
+            pieces.append(PiecewisePolynomial.ZeroOrderHold(
+                [start, end + shift], np.column_stack([q_place, q_place])))
+        else:
+            pieces.append(_delayed(piece, shift))
+    q_traj = CompositeTrajectory(pieces)
+    c = config
+    times = [t for t in plan.width_traj.get_segment_times() if t < t_at]
+    widths = [plan.width(t) for t in times]
+    times += [t_at, t_at + c.close_duration, t_at + c.close_duration + c.squeeze_duration,
+              t_at + c.close_duration + c.squeeze_duration + c.settle_duration,
+              t_opened - c.open_duration, t_opened]
+    widths += [plan.width(t_at), 0.0, c.closed_width, c.closed_width, 0.0, c.open_width]
+    later = [t for t in plan.width_traj.get_segment_times() if t > plan.t_place_done]
+    times += [t + shift for t in later] or [plan.duration + shift]
+    widths += [plan.width(t) for t in later] or [plan.width(plan.duration)]
+    width_traj = PiecewisePolynomial.FirstOrderHold(times, np.array([widths]))
+    segments = tuple((name, a + shift, b + shift, clearance) if a >= plan.t_place_done
+                     else (name, a, b, clearance) for name, a, b, clearance in plan.segments)
+    return dataclasses.replace(plan, q_traj=q_traj, v_traj=q_traj.MakeDerivative(),
+                               width_traj=width_traj, t_opened=t_opened, t_place_done=t_done,
+                               duration=plan.duration + shift, segments=segments)
+
+
+def _delayed(piece, shift: float):
+    """One piece of a plan's joint trajectory, `shift` seconds later."""
+    if isinstance(piece, BsplineTrajectory):
+        return shifted(piece, piece.start_time() + shift)
+    moved = PiecewisePolynomial(piece)
+    moved.shiftRight(shift)
+    return moved
 
 
 def place_pose(X_WO: np.ndarray, extents, place_xy, *, table_z: float = 0.0,
@@ -890,7 +956,9 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
         motion, hold_after = receiving(t, t_lift_done)
         add_hold(q["place"], max(motion.t_closed - t, 0.0))
     t_open = t
-    add_hold(q["place"], c.squeeze_duration + c.open_duration)
+    add_hold(q["place"], c.squeeze_duration + c.open_duration
+             + (0.0 if receiving is not None else c.release_dwell))
+    t_opened = None if receiving is not None else t - c.release_dwell
     t_place_done = t
     add_motion("retreat")
     if motion is not None and t < t_place_done + hold_after:
@@ -908,7 +976,7 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
                 X_WO_place=key.X_WO_place, waypoints=q, segments=tuple(rows),
                 R_turn=key.R_turn, t_pour=t_pour, t_descend=t_descend,
                 t_handover=None if motion is None else (motion.t_closed, t_place_done),
-                handover=motion)
+                handover=motion, t_opened=t_opened)
     return plan, "", True
 
 

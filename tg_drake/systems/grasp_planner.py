@@ -18,7 +18,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
 from tg_drake.grasping.feasibility import FeasibilityConfig
-from tg_drake.planning.planner import PlannerConfig, PlanResult
+from tg_drake.planning.planner import PlannerConfig, PlanResult, reseated
 from tg_drake.planning.regrasp import plan_task_leg
 from tg_drake.planning.task_motion import TaskPlacing
 from tg_drake.robot import IIWA_HOME
@@ -42,6 +42,7 @@ class _Memory:
     failure_reason: str = ""  # its reason (also for failures without a PlanResult)
     planning_time: float = 0.0  # [s] wall time
     ik_solves: int = 0  # inverse-kinematics solver calls of every request answered
+    reseats: int = 0  # re-seat requests answered for the current plan
 
     def __deepcopy__(self, memo):
         return self  # immutable: the simulator's state copies may share it
@@ -183,6 +184,11 @@ class GraspPlanner(LeafSystem):
     def _plan(self, context, state):
         memory: _Memory = context.get_abstract_state(self._memory).get_value()
         request = self._request(context)
+        if (request.attempt == memory.attempt and memory.result is not None
+                and request.reseats > memory.reseats):
+            state.get_mutable_abstract_state(self._memory).set_value(
+                self._reseat(memory, context.get_time() - memory.t_plan, request.reseats))
+            return EventStatus.Succeeded()
         if request.attempt <= memory.attempt:
             return EventStatus.DidNothing()
         if memory.result is not None:
@@ -217,7 +223,8 @@ class GraspPlanner(LeafSystem):
                                    feasibility=self._feasibility)
             memory = dataclasses.replace(memory, ik_solves=memory.ik_solves + result.ik_solves)
             if result.status == "planned":
-                memory = dataclasses.replace(memory, result=result, t_plan=context.get_time())
+                memory = dataclasses.replace(memory, result=result, t_plan=context.get_time(),
+                                             reseats=0)
             else:
                 memory = dataclasses.replace(memory, failure=result,
                                              failure_reason=result.reason)
@@ -225,6 +232,15 @@ class GraspPlanner(LeafSystem):
             memory, planning_time=memory.planning_time + time.perf_counter() - t0)
         state.get_mutable_abstract_state(self._memory).set_value(memory)
         return EventStatus.Succeeded()
+
+    def _reseat(self, memory: _Memory, t: float, reseats: int) -> _Memory:
+        """The plan with a re-seat inserted at plan time t when its pads stand open at the place
+        then; later than that the request is answered with the plan unchanged."""
+        plan = memory.result.plan
+        if plan.t_opened is not None and plan.t_opened <= t < plan.t_place_done:
+            plan = reseated(plan, t, self._config)
+        return dataclasses.replace(memory, result=dataclasses.replace(memory.result, plan=plan),
+                                   reseats=reseats)
 
     # Outputs.
     def _memory_of(self, context) -> _Memory:
@@ -249,7 +265,7 @@ class GraspPlanner(LeafSystem):
     def _calc_status(self, context, output):
         memory = self._memory_of(context)
         common = dict(attempt=memory.attempt, planning_time=memory.planning_time,
-                      ik_solves=memory.ik_solves)
+                      ik_solves=memory.ik_solves, reseats=memory.reseats)
         if memory.result is not None:
             plan = memory.result.plan
             done = context.get_time() - memory.t_plan >= plan.duration

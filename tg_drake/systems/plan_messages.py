@@ -36,6 +36,8 @@ class PlanRequest:
     # put down in an intermediate pose, `Plan.regrasp`), when the task's turn cannot be placed
     return_home: bool = False  # the plan ends with the arm back at its start configuration (out
     # of the camera's view), so that perception can look again after a missed grasp or lift
+    reseats: int = 0  # re-seats asked for in the plan being executed: while its pads stand open
+    # at the place, each one more makes the planner insert a re-seat (planning.planner.reseated)
 
 
 @dataclass(frozen=True)
@@ -55,6 +57,8 @@ class PlanStatus:
     ik_solves: int = 0  # inverse-kinematics solver calls of the planner so far
     t_plan: float | None = None  # [s] simulated time at which the plan starts
     plan: Plan | None = None  # the plan itself (key times in plan time: add t_plan)
+    reseats: int = 0  # the re-seats requests asked for that the plan now holds (or that came
+    # too late to insert: after the pads' pause at the place)
 
     @property
     def failed_part(self) -> str | None:

@@ -134,6 +134,7 @@ class Outcome:
     task_outcome: TaskOutcome | None = None  # the task's physical check (None: no task given)
     legs: tuple = ()  # the legs done before the final one (place-and-regrasp, retries): a dict
     # each (part, ended: placed / missed / slipped, placed_pose, xy [m] or None, t_end [s])
+    reseats: int = 0  # re-seats at the place: the object still touched a pad once they had opened
 
     @property
     def final(self) -> bool:
@@ -146,7 +147,7 @@ class Outcome:
                 "unreachable_parts": list(self.unreachable_parts), "requeries": self.requeries,
                 "task_outcome": (self.task_outcome.as_dict() if self.task_outcome is not None
                                  else None),
-                "legs": [dict(leg) for leg in self.legs]}
+                "legs": [dict(leg) for leg in self.legs], "reseats": self.reseats}
 
 
 def outcome_of_error(error: Exception, *, pending: Outcome | None = None) -> Outcome:
@@ -243,6 +244,8 @@ class _Memory:
     retries: int = 0  # legs ended by a missed grasp or a failed lift, looked at again
     look_after: float | None = None  # [s] ask perception to look once this time has passed (the
     # end of a plan whose grasp failed)
+    reseats: int = 0  # re-seats asked of the planner for the plan being executed
+    reseats_run: int = 0  # re-seats asked for in the whole run (Outcome.reseats)
 
     def __deepcopy__(self, memo):
         return self  # immutable: the simulator's state copies may share it
@@ -455,7 +458,7 @@ class Supervisor(LeafSystem):
         return dataclasses.replace(memory, phase=Phase.done, outcome=Outcome(
             status, reason, detail, reachable_parts=reachable,
             unreachable_parts=memory.collisions, requeries=memory.requeries,
-            task_outcome=task_outcome, legs=memory.legs))
+            task_outcome=task_outcome, legs=memory.legs, reseats=memory.reseats_run))
 
     def _gate(self, context, memory: _Memory) -> _Memory:
         scene: SceneDescription = self._scene_port.Eval(context)
@@ -503,7 +506,7 @@ class Supervisor(LeafSystem):
                                                                   PlanState.done):
             poses = self._poses_port.Eval(context)
             return dataclasses.replace(memory, phase=Phase.executing, status=status,
-                                       X_WO_picked=poses[self._model.object_body])
+                                       X_WO_picked=poses[self._model.object_body], reseats=0)
         if status.attempt >= memory.attempt and status.status is PlanState.failed:
             return self._after_failure(memory, status, self._grasps_port.Eval(context))
         start = self._config.planning_start if memory.t_leg is None else memory.t_leg
@@ -541,6 +544,11 @@ class Supervisor(LeafSystem):
                                    requeries=memory.requeries + 1)
 
     def _monitor(self, context, memory: _Memory) -> _Memory:
+        if memory.status.reseats < memory.reseats:  # a re-seat asked for: wait for its plan
+            status: PlanStatus = self._status_port.Eval(context)
+            if status.reseats < memory.reseats:
+                return memory
+            memory = dataclasses.replace(memory, status=status)
         plan, t_plan = memory.status.plan, memory.status.t_plan
         t = context.get_time() - t_plan
         pour = () if plan.t_pour is None else (plan.t_pour[1],)
@@ -552,8 +560,12 @@ class Supervisor(LeafSystem):
         # a place: the descent begins (it must still hold the object)
         t_descend = getattr(plan, "t_descend", None)
         carried = () if handover or t_descend is None else (t_descend,)
+        # a place: the pads stand open at the place (the object must have come free of them)
+        t_opened = getattr(plan, "t_opened", None)
+        opened = (() if not carried or t_opened is None
+                  else (t_opened + self._config.release_check_delay,))
         key_times = (plan.t_grasp_closed, plan.t_lift_done, *pour, *handover, *carried,
-                     plan.duration)
+                     *opened, plan.duration)
         key_time = key_times[memory.checks_passed]
         if memory.t_released is not None and t < key_time:  # pass: the height while held
             X = self._poses_port.Eval(context)[self._model.object_body]
@@ -596,6 +608,13 @@ class Supervisor(LeafSystem):
                 return self._finish(memory, Status.lifted, Reason.slipped,
                                     f"lost during the carry: not held as the descent to the "
                                     f"place began ({hand.describe()})")
+            return dataclasses.replace(memory, checks_passed=memory.checks_passed + 1)
+        if opened and memory.checks_passed == 3 + len(pour):  # the pads stand open at the place
+            if (hand.left or hand.right) and memory.reseats < self._config.max_reseats:
+                # Still touching a pad, the retreat could drag it along: the planner re-seats it
+                # (closes on it where it stands, opens again), then this check runs again.
+                return dataclasses.replace(memory, reseats=memory.reseats + 1,
+                                           reseats_run=memory.reseats_run + 1)
             return dataclasses.replace(memory, checks_passed=memory.checks_passed + 1)
         if memory.checks_passed == 2 and handover:  # pass: arrived at the hand-over pose
             if not hand.held:
@@ -768,7 +787,8 @@ class Supervisor(LeafSystem):
                                      regrasp=(self._task in REST_POSE_OF_TASK and len(
                                          memory.legs) - memory.retries
                                          < self._config.max_regrasps),
-                                     return_home=memory.retries < self._config.max_retries))
+                                     return_home=memory.retries < self._config.max_retries,
+                                     reseats=memory.reseats))
 
     def _calc_dispenser(self, context, output):
         """1 while a pourIn plan holds the container under the dispenser (its first
