@@ -66,7 +66,11 @@ IIWA_LINKS = {
 IIWA_COLOR = {"iiwa_link_0": "0.4 0.4 0.4 1", "iiwa_link_7": "0.4 0.4 0.4 1"}
 IIWA_ORANGE = "1.0 0.42 0.04 1"
 
-PAD_HYDRO = dict(modulus=1e6, resolution=0.005, dissipation=3.0, mu=WSG_PAD_FRICTION)
+# The pads' hydroelastic modulus [Pa]. At 1e6 a thin part under a 40-80 N grip (a tool's
+# handle, a container's wall) sank 3-5 mm into a 12 mm pad, most near its edges where the
+# pressure field is shallow: tools slipped at the lift and objects stayed stuck to a pad as it
+# opened. 1e7 (a stiff rubber) kept them out (docs/design.md, "Simulation settings").
+PAD_HYDRO = dict(modulus=1e7, resolution=0.005, dissipation=3.0, mu=WSG_PAD_FRICTION)
 
 # The table's facts and model are tg_drake.table's (the station sizes it from the scenario).
 

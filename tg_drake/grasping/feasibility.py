@@ -98,14 +98,13 @@ class FeasibilityConfig:
     min_p_hold: float = 0.5  # a candidate more likely to slip than to hold (P(hold) below this)
     # gets score 0, "would not hold" (with `rank_by_hold`).
     rank_by_hold: bool = True  # multiply the score by P(hold) and refuse below min_p_hold.
-    # The shipped model (1,230 episodes of 110 training objects, generated and scan-like)
-    # predicts held-out objects' episodes (Brier 0.165 against the base rate's 0.250, AUC 0.83:
-    # tg_drake/data/hold_model.report.json). Ranked by, on the executed generalization suites
-    # (254 runs, against the same code not ranking): 4 deliveries gained (a squat can by its
-    # middle; three pots, two taken by the top instead of a handle that turned in the pads),
-    # 1 lost (a spatula by its handle); the paper's Fig. 1 cup is still passed by its middle
-    # (P(hold) 0.90). An earlier fit (Brier 0.174) had refused that middle (0.49), and ranking
-    # was off until this model.
+    # The shipped model (1,225 episodes of 110 training objects, generated and scan-like, with
+    # the 1e7 Pa pads) predicts held-out objects' episodes (Brier 0.145 against the base rate's
+    # 0.249, AUC 0.86: tg_drake/data/hold_model.report.json). Ranking by an earlier fit, on the
+    # executed generalization suites (254 runs, against the same code not ranking): 4
+    # deliveries gained (a squat can by its middle; three pots, two taken by the top instead of
+    # a handle that turned in the pads), 1 lost (a spatula by its handle). The default scenario's
+    # cup is passed by its middle (P(hold) 0.89).
     # The geometric refusals (`tg_drake.grasping.pads.geometric_refusal`): each compares a
     # measure of the perceived points between the pads with one of these limits. They were
     # set from executed grasps, not fitted; the opening is `opening`.
