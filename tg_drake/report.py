@@ -379,6 +379,10 @@ def summary(result: dict) -> str:
         lines.append(f"closed loop: unreachable parts {o['unreachable_parts']} became "
                      f"collision evidence; {o['requeries']} "
                      f"re-quer{'y' if o['requeries'] == 1 else 'ies'}")
+    if o.get("reseats"):
+        lines.append(f"release    the object still touched a pad once they opened at the place: "
+                     f"re-seated {o['reseats']} time{'s' if o['reseats'] > 1 else ''} (closed on "
+                     f"it and opened again) before the retreat")
     t = result["timings"]
     lines.append("timings    " + ", ".join(f"{k} {v:.2f}s" for k, v in t.items()
                                           if k != "simulated_time"))

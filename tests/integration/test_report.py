@@ -41,3 +41,14 @@ def test_the_grasp_picture_title_and_the_summary_place_p_hold_as_the_stage_uses_
         result = {"grasp": grasp, "outcome": {"status": "placed"},
                   "config": {"pipeline": {"feasibility": {"rank_by_hold": ranked}}}}
         assert shown in _grasp_title(result)
+
+
+def test_the_summary_says_when_the_object_was_reseated_at_its_release():
+    from tg_drake.report import summary
+    outcome = {"status": "placed", "reason": "", "detail": "1.0 cm from the target",
+               "unreachable_parts": [], "requeries": 0}
+    result = {"scenario": "x", "timings": {"total": 1.0}, "outcome": outcome}
+    assert "release" not in summary(result)
+    result["outcome"] = dict(outcome, reseats=1)
+    line = next(x for x in summary(result).splitlines() if x.startswith("release"))
+    assert "re-seated 1 time " in line
