@@ -435,3 +435,22 @@ def test_judge_pass_reports_the_part_the_receiver_holds():
     assert ok.success and ok.measure["received_part"] == "handle"
     assert "by its handle" in ok.detail
     assert judged().measure["received_part"] == ""
+
+
+def test_a_container_is_not_squeezed_end_to_end_along_gravity_by_the_receiver():
+    """The bar seen as a container standing on its axis (not a tool, its frame's z vertical): the
+    turns of the top grasps that would close along the vertical, its axis, are not taken; as a
+    tool the same turns are allowed (a handle squeezed from above and below)."""
+    import dataclasses
+
+    container = dataclasses.replace(bar(0.3), is_tool=False)
+    kept = []
+    for target in (container, bar(0.3)):
+        grasp, why = choose_receiver_grasp(
+            candidates([-0.07, -0.10]), target=target, X_WO=target.X_WO,
+            X_WO_handover=target.X_WO, X_WG_robot=top_grasp(0.07, 0.3),
+            receiver_parts={"handle": 0.9, "usable_area": 0.1}, handover=HANDOVER,
+            table_z=0.0, retreat=0.1)
+        assert grasp is not None, why
+        kept.append(abs(grasp.X_WR[2, 0]))
+    assert kept[0] < 0.5  # the container's receiver closes across, not along, the vertical

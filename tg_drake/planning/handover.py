@@ -362,6 +362,20 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     carried = np.einsum("ij,njk->nik", moved, on_object)
     X_WR = np.array([V for X in carried for V in (X, *turned_about_width(X))])
     on_part = np.repeat(on_part, 1 + len(TURNS))
+    # A container not end to end along gravity: a receiver closing along the vertical and along
+    # its axis (a glass from rim to base) holds it on its lower pad, and when the robot lets go it
+    # drops by the error of the perceived extent's centre between the pads (15-57 mm in S_ROBOT's
+    # glass hand-overs). "Along": closer to it than to square (45°). (A tool's frame z is not its
+    # axis; its handle is squeezed from above and below on purpose: `turned_about_width`.)
+    if not getattr(target, "is_tool", False):
+        x_R = X_WR[:, :3, 0]
+        z_O = np.asarray(X_WO_handover, float)[:3, 2]
+        square = math.cos(math.radians(45.0))
+        end_to_end = (np.abs(x_R[:, 2]) > square) & (np.abs(x_R @ z_O) > square)
+        X_WR, on_part = X_WR[~end_to_end], on_part[~end_to_end]
+        if not len(X_WR):
+            return None, (f"hand-over: every receiver grasp on {wanted} would squeeze the object "
+                          f"end to end along gravity")
     cos_max = math.cos(math.radians(config.max_approach_angle))
     toward = X_WR[:, :3, 1] @ handover.direction >= cos_max - 1e-9
     wait = handover.X_WR_wait[:3, 3]
