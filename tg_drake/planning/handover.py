@@ -367,7 +367,7 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     # drops by the error of the perceived extent's centre between the pads (15-57 mm in S_ROBOT's
     # glass hand-overs). "Along": closer to it than to square (45°). (A tool's frame z is not its
     # axis; its handle is squeezed from above and below on purpose: `turned_about_width`.)
-    if not getattr(target, "is_tool", False):
+    if not target.is_tool:
         x_R = X_WR[:, :3, 0]
         z_O = np.asarray(X_WO_handover, float)[:3, 2]
         square = math.cos(math.radians(45.0))

@@ -194,6 +194,11 @@ class Plan:
     # and the arm back at its start (out of the camera's view): a place-and-regrasp's first leg
     # (tg_drake.planning.regrasp); the supervisor looks again and plans the next leg
 
+    def pads_open_at_place(self, t: float) -> bool:
+        """Whether at plan time t the pads stand open at the place before the retreat (where a
+        re-seat can be inserted: `reseated`)."""
+        return self.t_opened is not None and self.t_opened <= t < self.t_place_done
+
     def q(self, t: float) -> np.ndarray:
         """(7,) joint positions at plan time t (held at the ends outside [0, duration])."""
         t = min(max(t, 0.0), self.duration)
@@ -233,9 +238,22 @@ class PlanResult:
     # before a plan was found (`plan_task_leg`)
 
 
+def _closing(t0: float, c: PlannerConfig) -> list[tuple[float, float]]:
+    """(time [s], commanded opening [m]) knots of a grasp's close from `t0`: open → 0 over
+    `close_duration` (meeting a light object gently), then the squeeze to `closed_width`."""
+    return [(t0, c.open_width), (t0 + c.close_duration, 0.0),
+            (t0 + c.close_duration + c.squeeze_duration, c.closed_width)]
+
+
+def _releasing(t0: float, c: PlannerConfig) -> list[tuple[float, float]]:
+    """The knots of a release from `t0`: the squeeze back to 0, then open."""
+    return [(t0, c.closed_width), (t0 + c.squeeze_duration, 0.0),
+            (t0 + c.squeeze_duration + c.open_duration, c.open_width)]
+
+
 def reseat_duration(config: PlannerConfig) -> float:
     """[s] A re-seat: the pads close on the object where it stands, squeeze, settle, let go and
-    open again (the grasp's own timing)."""
+    open again (the grasp's own timing: `_closing`, `settle_duration`, `_releasing`)."""
     return (config.close_duration + 2 * config.squeeze_duration + config.settle_duration
             + config.open_duration)
 
@@ -247,7 +265,7 @@ def reseated(plan: Plan, t_at: float, config: PlannerConfig) -> Plan:
     `config.release_dwell` more, then retreats as planned. An object that settled against one
     pad as the pads opened (a lying cup rolling onto the pad whose tip is under its rim) is
     pushed back between them, and let go from rest. Everything after the place is delayed."""
-    if plan.t_opened is None or not plan.t_opened <= t_at < plan.t_place_done:
+    if not plan.pads_open_at_place(t_at):
         raise ValueError(f"a re-seat needs the pads open at the place: t_at = {t_at} s outside "
                          f"[{plan.t_opened}, {plan.t_place_done}) s")
     t_opened = t_at + reseat_duration(config)
@@ -266,17 +284,13 @@ def reseated(plan: Plan, t_at: float, config: PlannerConfig) -> Plan:
         else:
             pieces.append(_delayed(piece, shift))
     q_traj = CompositeTrajectory(pieces)
-    c = config
-    times = [t for t in plan.width_traj.get_segment_times() if t < t_at]
-    widths = [plan.width(t) for t in times]
-    times += [t_at, t_at + c.close_duration, t_at + c.close_duration + c.squeeze_duration,
-              t_at + c.close_duration + c.squeeze_duration + c.settle_duration,
-              t_opened - c.open_duration, t_opened]
-    widths += [plan.width(t_at), 0.0, c.closed_width, c.closed_width, 0.0, c.open_width]
-    later = [t for t in plan.width_traj.get_segment_times() if t > plan.t_place_done]
-    times += [t + shift for t in later] or [plan.duration + shift]
-    widths += [plan.width(t) for t in later] or [plan.width(plan.duration)]
-    width_traj = PiecewisePolynomial.FirstOrderHold(times, np.array([widths]))
+    before = [(t, plan.width(t)) for t in plan.width_traj.get_segment_times() if t < t_at]
+    released = t_opened - config.squeeze_duration - config.open_duration
+    later = [(t + shift, plan.width(t)) for t in plan.width_traj.get_segment_times()
+             if t > plan.t_place_done] or [(plan.duration + shift, plan.width(plan.duration))]
+    knots = before + _closing(t_at, config) + _releasing(released, config) + later
+    width_traj = PiecewisePolynomial.FirstOrderHold([t for t, _ in knots],
+                                                    np.array([[w for _, w in knots]]))
     segments = tuple((name, a + shift, b + shift, clearance) if a >= plan.t_place_done
                      else (name, a, b, clearance) for name, a, b, clearance in plan.segments)
     return dataclasses.replace(plan, q_traj=q_traj, v_traj=q_traj.MakeDerivative(),
@@ -964,11 +978,10 @@ def _trajectories(arms: _Arms, q_start, poses, key: _KeyPoses, config, seeds, *,
     if motion is not None and t < t_place_done + hold_after:
         add_hold(q["retreat"], t_place_done + hold_after - t)
     q_traj = CompositeTrajectory(pieces)
-    width_traj = PiecewisePolynomial.FirstOrderHold(
-        [0.0, t_close, t_close + c.close_duration, t_close + c.close_duration + c.squeeze_duration,
-         t_open, t_open + c.squeeze_duration, t_open + c.squeeze_duration + c.open_duration, t],
-        np.array([[c.open_width, c.open_width, 0.0, c.closed_width, c.closed_width, 0.0,
-                   c.open_width, c.open_width]]))
+    knots = [(0.0, c.open_width), *_closing(t_close, c), *_releasing(t_open, c),
+             (t, c.open_width)]
+    width_traj = PiecewisePolynomial.FirstOrderHold([k for k, _ in knots],
+                                                    np.array([[w for _, w in knots]]))
     plan = Plan(q_traj=q_traj, v_traj=q_traj.MakeDerivative(), width_traj=width_traj,
                 t_grasp_closed=t_grasp_closed, t_lift_done=t_lift_done,
                 t_place_done=t_place_done, duration=t, candidate=candidate, part=part,

@@ -237,7 +237,7 @@ class GraspPlanner(LeafSystem):
         """The plan with a re-seat inserted at plan time t when its pads stand open at the place
         then; later than that the request is answered with the plan unchanged."""
         plan = memory.result.plan
-        if plan.t_opened is not None and plan.t_opened <= t < plan.t_place_done:
+        if plan.pads_open_at_place(t):
             plan = reseated(plan, t, self._config)
         return dataclasses.replace(memory, result=dataclasses.replace(memory.result, plan=plan),
                                    reseats=reseats)
