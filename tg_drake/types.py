@@ -16,6 +16,7 @@ coordinates; ``n_W`` normals in world coordinates. Cores never need pydrake to u
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -115,6 +116,21 @@ class ObjectDescription:
     # [m], its wall's (narrowing, error) [m/m] (NaN: no wall) and 1.0 when the end radii read
     # the top narrower than the base (else 0.0), when the pose reached that cue
     # (perception.pose.closed_end, wall_taper, PoseEstimate.narrower_top), else None.
+
+
+def moved_rigidly(target: ObjectDescription, T: np.ndarray) -> ObjectDescription:
+    """`target` moved rigidly by T (4×4, world): its points, normals, frame, part boxes and
+    pre-grasp poses; its pose label and everything else kept as perceived."""
+    T = np.asarray(T, float)
+    R, t = T[:3, :3], T[:3, 3]
+    boxes = {name: PartBox(T @ np.asarray(b.X_WB, float), np.asarray(b.half_extents, float))
+             for name, b in target.part_boxes.items()}
+    p_W = np.asarray(target.p_W, float).reshape(-1, 3)
+    n_W = np.asarray(target.n_W, float).reshape(-1, 3)
+    X_WG = np.asarray(target.pregrasp_X_WG, float).reshape(-1, 4, 4)
+    return dataclasses.replace(target, p_W=p_W @ R.T + t, n_W=n_W @ R.T,
+                               X_WO=T @ np.asarray(target.X_WO, float), part_boxes=boxes,
+                               pregrasp_X_WG=np.einsum("ij,njk->nik", T, X_WG))
 
 
 @dataclass

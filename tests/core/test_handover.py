@@ -454,3 +454,40 @@ def test_a_container_is_not_squeezed_end_to_end_along_gravity_by_the_receiver():
         assert grasp is not None, why
         kept.append(abs(grasp.X_WR[2, 0]))
     assert kept[0] < 0.5  # the container's receiver closes across, not along, the vertical
+
+
+def test_the_receiver_is_refused_what_the_robot_would_be_refused(monkeypatch):
+    """The geometric refusals of the robot's grasps apply to the receiver's (those of an object
+    on the table aside): here fingers closing along an 80 mm rod, 12 mm thick, held in the air.
+    Without the refusal the same pose would be taken."""
+    from tg_drake.types import PartBox
+
+    g = np.arange(-0.04, 0.0401, 0.003)
+    h = np.arange(-0.006, 0.00601, 0.003)
+    p = np.stack(np.meshgrid(g, h, h, indexing="ij"), axis=-1).reshape(-1, 3) + [0, 0, 0.3]
+    X_WO = np.eye(4)
+    X_WO[2, 3] = 0.3
+    X_WB = X_WO.copy()
+    rod = ObjectDescription(
+        p_W=p, n_W=np.zeros_like(p), labels=np.full(len(p), PART_LABELS.index("handle")),
+        visible=np.ones(len(p), bool), X_WO=X_WO, extents=np.array([0.08, 0.012, 0.012]),
+        pose="sideways", pose_likelihood={"sideways": 1.0}, part_probabilities={"handle": 1.0},
+        part_boxes={"handle": PartBox(X_WB, np.array([0.04, 0.006, 0.006]))},
+        pregrasp_X_WG=np.zeros((0, 4, 4)), pregrasp_parts=np.zeros(0, int), is_tool=True)
+    along = np.eye(4)  # from above, closing along x_W (the rod's length)
+    along[:3, :3] = np.column_stack([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+    along[:3, 3] = [0.0, 0.0, 0.3 + GRASP_DEPTH]
+    cands = GraspCandidates(X_WG=along[None], parts=np.array([PART_LABELS.index("handle")]),
+                            p_part=np.ones(1), p_local=np.full(1, 0.5), score=np.full(1, 0.5))
+    monkeypatch.setattr(handover_module, "TURNS", ())
+
+    def receive():
+        return choose_receiver_grasp(
+            cands, target=rod, X_WO=X_WO, X_WO_handover=X_WO, X_WG_robot=top_grasp(0.4, 0.3),
+            receiver_parts={"handle": 1.0}, handover=HANDOVER, table_z=0.0, retreat=0.1)
+
+    grasp, why = receive()
+    assert grasp is None and "close along the 0.080 m" in why, why
+    monkeypatch.setattr(handover_module, "geometric_refusal", lambda *a, **k: "")
+    grasp, why = receive()
+    assert grasp is not None, why

@@ -238,6 +238,9 @@ def test_an_object_past_both_pads_is_refused_one_past_a_single_pad_is_not():
     short.p_W = np.array([[0.7 + x, 0.0275 * np.cos(a), 0.03 + 0.0275 * np.sin(a)]
                           for x in np.linspace(-0.051, 0.051, 27) for a in t])
     assert "could not let go" in geometric_refusal(short, "middle", X, None, config)
+    # Held in the air by another gripper (a pass's receiver taking it), nothing is let go here.
+    assert "could not let go" not in geometric_refusal(short, "middle", X, None, config,
+                                                       held=True)
     # A cup's handle reaching past one pad only: the fingers open clear of the other side.
     cup = box_object([0.7, 0.0, 0.03], [0.105, 0.075, 0.06], parts=("middle",))
     cup.p_W = can.p_W[np.abs(can.p_W[:, 0] - 0.7) <= 0.0375] + [0.0, 0.0, 0.0]

@@ -206,7 +206,7 @@ COLLISION = "collision: "  # how a refusal of a gripper that would hit something
 
 
 def geometric_refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, centroid,
-                      config, table_z: float = 0.0) -> str:
+                      config, table_z: float = 0.0, *, held: bool = False) -> str:
     """Why the geometry of the grasp X_WG on `part` rules it out ("" if it does not), in three
     classes told by how the reason begins: DOES_NOT_FIT (the part or the object does not fit the
     opening, or could not be let go), COLLISION (an open pad would come down on a tool) and
@@ -215,7 +215,10 @@ def geometric_refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, ce
     only on the upper half of a tool lying on the table — its top at height `table_z` —, or the
     object's weight would turn it in the pads). `config`: the stage's
     `tg_drake.grasping.feasibility.FeasibilityConfig` (its limits; that module imports this one).
-    `centroid`: the object's perceived centroid (None: no points)."""
+    `centroid`: the object's perceived centroid (None: no points). `held`: the object hangs in
+    another gripper (a pass's receiver taking it from the robot): what concerns an object
+    standing or lying on the table — letting it go there, an open pad coming down on a tool
+    resting on it, a tool squeezed down against it — does not apply; the rest does."""
     opening = config.opening
     width = part_width(target, part, X_WG)
     if width > opening - config.width_margin:
@@ -231,13 +234,13 @@ def geometric_refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, ce
     # wall in a rim grasp) the fingers still open clear of it.
     lo, hi = extent_along_closing(target, X_WG, config.release_band)
     half = (opening - config.release_gap) / 2
-    if -lo > half and hi > half:
+    if not held and -lo > half and hi > half:
         return (f"{DOES_NOT_FIT}the object reaches past both pads ({hi - lo:.3f} m along the "
                 f"closing axis there; its {part} {width:.3f} m): the WSG, open to {opening} m, "
                 "could not let go")
     # Tools only: what lies under a pad of a tool lying on the table rests on the table and
     # stops the pad; a container's wall or handle under a pad may yield (`max_pad_cover`).
-    cover = open_pad_cover(target, X_WG, opening) if target.is_tool else 0.0
+    cover = open_pad_cover(target, X_WG, opening) if target.is_tool and not held else 0.0
     if cover > config.max_pad_cover:
         return (f"{COLLISION}an open pad would come down on the object (it lies under "
                 f"{cover:.0%} of the pad's cross-section, at most {config.max_pad_cover:.0%})")
@@ -260,7 +263,7 @@ def geometric_refusal(target: ObjectDescription, part: str, X_WG: np.ndarray, ce
         return (f"{WOULD_NOT_HOLD}the pads would touch the object's widest section over only "
                 f"{share:.0%} of the width the object fills between them (at least "
                 f"{config.min_contact_share:.0%}): a step or taper under the pads squeezes out")
-    if target.is_tool:
+    if target.is_tool and not held:
         area = pad_area_below_middle(target, X_WG, opening, table_z, seen=seen)
         if area < config.min_tool_grip_area:
             return (f"{WOULD_NOT_HOLD}the pads would press on only {area * 1e6:.0f} mm² of the "

@@ -60,10 +60,13 @@ from tg_drake.grasping.feasibility import (
     grip_width,
     gripper_boxes,
 )
-from tg_drake.grasping.pads import GRASP_DEPTH  # [m] the grasp point along +y_G
+from tg_drake.grasping.pads import (
+    GRASP_DEPTH,  # [m] the grasp point along +y_G
+    geometric_refusal,
+)
 from tg_drake.robot import WSG_GRASP_POINT_G, WSG_MAX_OPENING, WSG_PAD_SIZE, wrist_reach_margin
 from tg_drake.tasks.judge import PASS_HOLD_DURATION
-from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription
+from tg_drake.types import PART_LABELS, GraspCandidates, ObjectDescription, moved_rigidly
 
 UP = np.array([0.0, 0.0, 1.0])
 
@@ -397,7 +400,8 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     key = (np.round(X_OG, 6).tobytes(), round(float(X_WO_handover[2, 3]) - table_z, 6),
            keep.tobytes(), hashlib.sha1(arm_O.tobytes()).hexdigest())
     if cache is None or key not in cache:
-        target_p_W = (np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3])
+        carried_target = moved_rigidly(target, moved)
+        target_p_W = carried_target.p_W
         grip = grip_width(X_WG_robot, target_p_W, WSG_MAX_OPENING)
         robot = np.concatenate([robot_gripper_points(
             X_WG_robot, retreat=retreat, closed_width=grip,
@@ -405,15 +409,23 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
         f = grasp_feasibility(X_WR[keep], target_p_W=target_p_W, others_p_W=robot,
                               table_z=table_z, approach=config.approach, category=category,
                               config=feasibility)
+        # The object hangs in the robot's grip: a receiver whose housing or open pads, coming
+        # in along its approach, cut it would push it round in that grip (a gripper on an object
+        # on the table may push it onto the table: the hold model weighs that there, not here).
+        # Then the geometric refusals of the robot's own grasps (pads.geometric_refusal), but
+        # those of an object on the table: fingers closing along a long part, too little of the
+        # object between the pads, a step under them, a weight that would turn it in them.
+        centroid = target_p_W.mean(axis=0) if len(target_p_W) else None
+        reasons = []
+        for j, (r, h) in enumerate(zip(f.reasons, f.holds, strict=True)):
+            r = r or _pushes(h, feasibility.point_tolerance)
+            reasons.append(r or geometric_refusal(
+                carried_target, names[on_part[keep[j]]], X_WR[keep[j]], centroid, feasibility,
+                table_z, held=True))
         if cache is not None:
-            cache[key] = f
+            cache[key] = (f, reasons)
     else:
-        f = cache[key]
-    # The object hangs in the robot's grip: a receiver whose housing or open pads, coming in
-    # along its approach, cut it would push it round in that grip (a gripper on an object on
-    # the table may push it onto the table: the hold model weighs that there, not here).
-    reasons = [r or _pushes(h, feasibility.point_tolerance) for r, h in zip(f.reasons, f.holds,
-                                                                            strict=True)]
+        f, reasons = cache[key]
     ok = np.array([not r for r in reasons], bool)
     if not ok.any():
         first = next((r for r in reasons if r), "")

@@ -66,7 +66,13 @@ from tg_drake.planning.task_motion import (
     smallest_turn,
 )
 from tg_drake.planning.trajectory import plan_segment, shifted
-from tg_drake.types import PART_LABELS, POSES, GraspCandidates, ObjectDescription, PartBox
+from tg_drake.types import (
+    PART_LABELS,
+    POSES,
+    GraspCandidates,
+    ObjectDescription,
+    moved_rigidly,
+)
 
 # How many pre-grasp hypotheses of the moved object the second leg's reach check tries.
 SECOND_LEG_GRASPS = 24
@@ -116,17 +122,13 @@ def moved_object(target: ObjectDescription, X_WO_new: np.ndarray,
     boxes, its pose label from the new frame, and the pre-grasp hypotheses of its moved part
     boxes (as perception makes them)."""
     T = np.asarray(X_WO_new, float) @ np.linalg.inv(np.asarray(target.X_WO, float))
-    R, t = T[:3, :3], T[:3, 3]
-    boxes = {name: PartBox(T @ np.asarray(b.X_WB, float), np.asarray(b.half_extents, float))
-             for name, b in target.part_boxes.items()}
-    X_WG, parts = part_pregrasps({n: (b.X_WB, b.half_extents) for n, b in boxes.items()},
+    moved = moved_rigidly(target, T)
+    X_WG, parts = part_pregrasps({n: (b.X_WB, b.half_extents) for n, b in moved.part_boxes.items()},
                                  PART_LABELS.index, pregrasp)
-    p_W = np.asarray(target.p_W, float).reshape(-1, 3)
-    n_W = np.asarray(target.n_W, float).reshape(-1, 3)
     return dataclasses.replace(
-        target, p_W=p_W @ R.T + t, n_W=n_W @ R.T, X_WO=np.asarray(X_WO_new, float),
-        pose=perceived_pose(R @ np.asarray(target.X_WO)[:3, :3], is_tool=target.is_tool),
-        part_boxes=boxes, pregrasp_X_WG=X_WG, pregrasp_parts=np.asarray(parts, int))
+        moved, X_WO=np.asarray(X_WO_new, float),
+        pose=perceived_pose(T[:3, :3] @ np.asarray(target.X_WO)[:3, :3], is_tool=target.is_tool),
+        pregrasp_X_WG=X_WG, pregrasp_parts=np.asarray(parts, int))
 
 
 def _second_leg_grasps(moved: ObjectDescription, table_z: float, carried=None, *,
