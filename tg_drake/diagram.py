@@ -46,7 +46,7 @@ from pydrake.systems.framework import DiagramBuilder, EventStatus, LeafSystem
 
 from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.grasping.model import load_model
-from tg_drake.objects import box_centre, get_object, mesh
+from tg_drake.objects import box_centre, get_object, mesh, sample_surface
 from tg_drake.planning.task_motion import dispenser_obstacle, surfaces_in_world, task_placing
 from tg_drake.receiver import ReceiverDriver, handover_of
 from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario, place_surface
@@ -69,6 +69,10 @@ from tg_drake.targeting import select_target
 from tg_drake.tasks.contents import hopper_height
 from tg_drake.tasks.judge import contents_counter
 from tg_drake.types import SceneDescription
+
+# [m] the spacing of the points on the target's surface the pass's receiver compares shapes with
+# (tg_drake.receiver.seen_correction): under its see_tolerance's reach (3 mm) over a few points.
+RECEIVER_SURFACE_SPACING = 0.005
 
 
 class TargetSelector(LeafSystem):
@@ -273,9 +277,12 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
                     station.inputs["iiwa.desired_state"])
     builder.Connect(planner.GetOutputPort("wsg.position"), station.inputs["wsg.position"])
     if "receiver.mount" in station.inputs:  # a pass: the receiver follows the plan's hand-over
+        shape = sample_surface(target_placement.id, spacing=RECEIVER_SURFACE_SPACING,
+                               rng=np.random.default_rng(0))[:2]
         receiver = builder.AddNamedSystem("receiver_driver", ReceiverDriver(
             handover_of(scenario),
-            object_body=int(station.object_body(target_placement.instance_name).index())))
+            object_body=int(station.object_body(target_placement.instance_name).index()),
+            surface=shape))
         builder.Connect(planner.GetOutputPort("plan_status"), receiver.GetInputPort("plan_status"))
         builder.Connect(station.outputs["body_poses"], receiver.GetInputPort("body_poses"))
         for name in ("receiver.mount", "receiver.position"):

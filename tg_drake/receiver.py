@@ -193,6 +193,45 @@ def _first_velocity(plant, instance) -> int:
                if plant.get_joint(j).num_velocities() > 0)
 
 
+# [m] how far apart the receiver matches a point of the object's surface where the plan carries
+# it to the surface where it is, when it looks for the smallest move that shows the same shape
+# (`seen_correction`): a few times the tolerance, under the drifts it must follow by the frame.
+SEE_MATCH_DISTANCE = 0.02
+
+
+def seen_correction(C: np.ndarray, X_expected: np.ndarray, p_O: np.ndarray, n_O: np.ndarray,
+                    tolerance: float) -> np.ndarray:
+    """The move (4×4, world) the receiver follows, given the object's true move C (X_WO ·
+    X_expected⁻¹) from where the plan carries it (X_expected) and its surface (points p_O,
+    outward normals n_O, (n, 3), its frame): the smallest move that shows the same shape — an
+    ICP (Open3D, point to plane, from no move) of the surface where it is expected onto where it
+    is — when it matches within `tolerance` [m] (95th percentile of the point-to-plane
+    distances), else C. A person sees the shape, not the frame: a glass rolled about its axis in
+    the robot's hand looks as it did, and following the frame's roll would swing the receiver's
+    way in about the object (into the robot's arm); a cup turned so is followed by its handle."""
+    import open3d as o3d
+    from scipy.spatial import cKDTree
+
+    p_O, n_O = np.asarray(p_O, float), np.asarray(n_O, float)
+    X_expected, C = np.asarray(X_expected, float), np.asarray(C, float)
+    X_actual = C @ X_expected
+    source = p_O @ X_expected[:3, :3].T + X_expected[:3, 3]
+    target = p_O @ X_actual[:3, :3].T + X_actual[:3, 3]
+    normals = n_O @ X_actual[:3, :3].T
+    src, tgt = o3d.geometry.PointCloud(), o3d.geometry.PointCloud()
+    src.points = o3d.utility.Vector3dVector(source)
+    tgt.points = o3d.utility.Vector3dVector(target)
+    tgt.normals = o3d.utility.Vector3dVector(normals)
+    reg = o3d.pipelines.registration
+    T = np.asarray(reg.registration_icp(
+        src, tgt, SEE_MATCH_DISTANCE, np.eye(4), reg.TransformationEstimationPointToPlane(),
+        reg.ICPConvergenceCriteria(max_iteration=30)).transformation)
+    moved = source @ T[:3, :3].T + T[:3, 3]
+    _, i = cKDTree(target).query(moved)
+    gap = np.abs(np.einsum("ij,ij->i", moved - target[i], normals[i]))
+    return T if np.percentile(gap, 95) <= tolerance else C
+
+
 class ReceiverDriver(LeafSystem):
     """Commands the receiver from the planner's ``plan_status``: the plan's hand-over motion
     (`Plan.handover`) in plan time, else where it waits with its fingers open.
@@ -214,14 +253,18 @@ class ReceiverDriver(LeafSystem):
     (rigidly from where it stood, with the robot's gripper: `HandoverMotion.X_WG_robot` ·
     `Plan.X_WG_grasp`⁻¹ · the pose at the plan's start) and moves its motion from then on with the
     difference (an object that shifted in the robot's hand as the pads closed); then the
-    correction is kept. The robot's pipeline never sees it.
+    correction is kept. Given the object's `surface` (points and outward normals in its frame),
+    it follows the smallest move that shows the same shape instead (`seen_correction`). The
+    robot's pipeline never sees it.
     """
 
     def __init__(self, handover: Handover, *, object_body: int | None = None,
-                 period: float = 0.05):
+                 period: float = 0.05, surface: tuple[np.ndarray, np.ndarray] | None = None):
         super().__init__()
         self._q_wait = mount_configuration(handover.X_WR_wait)
         self._object = object_body
+        self._surface = surface
+        self._see = handover.config.see_tolerance
         self._status = self.DeclareAbstractInputPort(
             "plan_status", AbstractValue.Make(PlanStatus(PlanState.planning)))
         self._poses = self.DeclareAbstractInputPort(
@@ -251,6 +294,8 @@ class ReceiverDriver(LeafSystem):
             return
         expected = motion.X_WG_robot @ np.linalg.inv(np.asarray(plan.X_WG_grasp)) @ X_start
         C = X_WO @ np.linalg.inv(expected)
+        if self._surface is not None:
+            C = seen_correction(C, expected, *self._surface, self._see)
         state.get_mutable_abstract_state(0).set_value((X_start, C))
 
     def _motion(self, context):

@@ -125,11 +125,12 @@ def test_a_receiver_grasp_that_would_push_the_held_object_is_refused(monkeypatch
 
 def test_the_receiver_keeps_its_clearance_from_the_robots_gripper():
     # The robot's housing spans x 0.045 … 0.095 m (its grasp at x 0.07, the housing 50 mm along
-    # the pads' width, x_W here); a receiver's at x 0.018 m ends at 0.043 m: 2 mm from it.
+    # the pads' width, x_W here); a receiver's at x 0.018 m ends at 0.043 m: 2 mm from it. (The
+    # receiver waits on the −x side, its way in clear of the robot's gripper.)
     target = bar(0.3)
 
     def receive(clearance):
-        handover = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=180.0,
+        handover = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=0.0,
                                            clearance=clearance), np.eye(4))
         return choose_receiver_grasp(
             candidates([0.018]), target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
@@ -141,7 +142,7 @@ def test_the_receiver_keeps_its_clearance_from_the_robots_gripper():
     assert grasp is None and "clear of the robot's gripper" in why
     # 1 mm into the robot's housing: refused at no clearance too (its geometry is exact: the
     # perceived points' 2 mm tolerance does not apply).
-    handover = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=180.0), np.eye(4))
+    handover = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=0.0), np.eye(4))
     grasp, why = choose_receiver_grasp(
         candidates([0.021]), target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
         X_WG_robot=top_grasp(0.07, 0.3), receiver_parts={"usable_area": 1.0},
@@ -491,3 +492,33 @@ def test_the_receiver_is_refused_what_the_robot_would_be_refused(monkeypatch):
     monkeypatch.setattr(handover_module, "geometric_refusal", lambda *a, **k: "")
     grasp, why = receive()
     assert grasp is not None, why
+
+
+def test_a_receiver_whose_way_in_crosses_the_robots_gripper_is_refused():
+    """Waiting on the +x side (yaw 180°: it moves along −x), the receiver would pass through the
+    robot's housing (x 0.045 … 0.095 m) on its way to a grasp at x 0.018 m; from the −x side
+    (yaw 0°) the same grasp is taken. The transit's poses run from where it waits to the
+    pre-grasp, no point of its open gripper moving more than TRANSIT_STEP between two."""
+    from tg_drake.grasping.feasibility import gripper_boxes
+    from tg_drake.planning.handover import TRANSIT_STEP, transit_poses
+
+    target = bar(0.3)
+    outcome = {}
+    for yaw in (180.0, 0.0):
+        handover = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=yaw), np.eye(4))
+        outcome[yaw] = choose_receiver_grasp(
+            candidates([0.018]), target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
+            X_WG_robot=top_grasp(0.07, 0.3), receiver_parts={"usable_area": 1.0},
+            handover=handover, table_z=0.0, retreat=0.1)
+        X = transit_poses(handover, top_grasp(0.018, 0.3))
+        assert np.allclose(X[0], handover.X_WR_wait)
+        pre = top_grasp(0.018, 0.3)
+        pre[:3, 3] -= handover.config.approach * pre[:3, 1]
+        assert np.allclose(X[-1], pre, atol=1e-9)
+        corners = np.array([c + s * h for _, c, h in gripper_boxes(0.11)
+                            for s in np.array(np.meshgrid(*[(-1, 1)] * 3)).reshape(3, -1).T])
+        p = np.einsum("nij,kj->nki", X[:, :3, :3], corners) + X[:, None, :3, 3]
+        assert np.linalg.norm(np.diff(p, axis=0), axis=2).max() <= TRANSIT_STEP + 1e-9
+    grasp, why = outcome[180.0]
+    assert grasp is None and "would cross the robot's arm or gripper" in why
+    assert outcome[0.0][0] is not None, outcome[0.0][1]

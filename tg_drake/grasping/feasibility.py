@@ -261,6 +261,19 @@ def penetration(X_WG: np.ndarray, p_W: np.ndarray, boxes, k: int) -> dict[str, f
                         np.array([h for _, _, h in boxes]), k)[0])
 
 
+def deepest_cuts(X_WG: np.ndarray, p_W: np.ndarray, boxes, k: int) -> np.ndarray:
+    """(M,) how deep [m] the points p_W (n, 3) cut the deepest of the gripper's `boxes` (name,
+    centre, half size in G) at each pose X_WG (M, 4, 4): `penetration`'s measure (the k-th
+    deepest point of a box; 0 when fewer than k points are inside), many poses at once."""
+    X_WG = np.asarray(X_WG, float).reshape(-1, 4, 4)
+    p_W = np.asarray(p_W, float).reshape(-1, 3)
+    centre = np.array([c for _, c, _ in boxes])
+    half = np.array([h for _, _, h in boxes])
+    step = max(1, _BATCH_POINTS // max(len(p_W), 1))  # poses × points held at once
+    return np.concatenate([_cuts(_in_G(X_WG[i:i + step], p_W), centre, half, k).max(axis=1)
+                           for i in range(0, len(X_WG), step)]) if len(X_WG) else np.zeros(0)
+
+
 @dataclass(frozen=True)
 class Collision:
     """How the gripper meets what it must not touch (the other objects, the table)."""

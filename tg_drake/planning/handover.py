@@ -56,6 +56,7 @@ from tg_drake.errors import ScenarioError
 from tg_drake.grasping.feasibility import (
     FeasibilityConfig,
     closing_sweep,
+    deepest_cuts,
     grasp_feasibility,
     grip_width,
     gripper_boxes,
@@ -107,6 +108,10 @@ class ReceiverConfig:
     approach_speed: float = 0.1  # [m/s] the straight approach (peak: 1.875 × the mean)
     look: float = 0.3  # [s] at its pre-grasp after the robot has arrived, before approaching:
     # where the object is in the robot's hand is seen then (tg_drake.receiver.ReceiverDriver)
+    see_tolerance: float = 0.003  # [m] what the receiver tells apart when it compares the
+    # object's shape where it is with where the plan carries it (95th percentile of the surface
+    # distance; about a D415's depth noise at half a metre): a turn of the object it cannot see
+    # (a lying glass rolled about its axis) is not followed (tg_drake.receiver.seen_correction)
     close_duration: float = 0.8  # [s] open → 0 (then → closed_width over squeeze_duration), as
     # the robot's gripper closes (PlannerConfig)
     squeeze_duration: float = 0.1  # [s]
@@ -140,6 +145,7 @@ class ReceiverConfig:
                   ("clearance", self.clearance >= 0.0, ">= 0 m"),
                   ("max_grasps", self.max_grasps >= 1, ">= 1"),
                   ("look", self.look >= 0.0, ">= 0 s"),
+                  ("see_tolerance", self.see_tolerance > 0.0, "> 0 m"),
                   ("speed", self.speed > 0.0, "> 0 m/s"),
                   ("turn_speed", self.turn_speed > 0.0, "> 0 rad/s"),
                   ("approach_speed", self.approach_speed > 0.0, "> 0 m/s"),
@@ -437,7 +443,30 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     score = np.where(ok, p_recv[idx] * p_local * f.p_hold, -1.0)
     # Poses whose contact mechanics hold the weight (margin ≥ 1) first, then by score.
     margin = np.array([h.margin >= 1.0 for h in f.holds], bool) & ok
-    best = int(np.argmax(score + 2.0 * margin))  # scores lie in [0, 1]
+    # The first of them whose transit, from where the receiver waits to its pre-grasp, keeps
+    # clear of the robot's arm and gripper (holding, its pads at the grip width: the robot
+    # stands still at the hand-over while the receiver comes) and of the object: a receiver
+    # passing through the arm strikes it and knocks the object out of the robot's hand.
+    target_p_W = np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3]
+    grip = grip_width(X_WG_robot, target_p_W, WSG_MAX_OPENING)
+    X_WG_robot = np.asarray(X_WG_robot, float)
+    robot_G = np.concatenate([_box_grid(centre, half + config.clearance, 0.005)
+                              for _, centre, half in gripper_boxes(max(grip, 0.0))])
+    obstacles = np.concatenate([robot_G @ X_WG_robot[:3, :3].T + X_WG_robot[:3, 3], arm,
+                                target_p_W])
+    best, blocked = None, 0
+    for j in np.argsort(-(score + 2.0 * margin), kind="stable"):  # scores lie in [0, 1]
+        if not ok[j]:
+            break
+        cut = transit_cut(handover, X_WR[keep[j]], obstacles, feasibility.min_points)
+        if cut <= feasibility.point_tolerance:
+            best = int(j)
+            break
+        blocked += 1
+    if best is None:
+        return None, (f"hand-over: the receiver's way from where it waits to each of its "
+                      f"{blocked} grasps on {wanted} clear at the hand-over would cross the "
+                      f"robot's arm or gripper or the object")
     i = int(idx[best])
     return ReceiverGrasp(X_WR[keep][best], names[i], i, float(p_recv[i]), float(p_local[best]),
                          float(f.p_hold[best]), float(score[best]),
@@ -581,6 +610,44 @@ def _duration(q_a: np.ndarray, q_b: np.ndarray, speed: float, turn_speed: float,
     return max(minimum, 1.875 * d)
 
 
+def _transit(handover: Handover, X_WR: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The mount's q where the receiver waits and at its pre-grasp for grasp X_WR (`approach`
+    back along its approach, −y_R): its transit runs straight from one to the other in q."""
+    q_wait = mount_configuration(handover.X_WR_wait)
+    X_pre = np.array(X_WR, float)
+    X_pre[:3, 3] -= handover.config.approach * X_pre[:3, 1]
+    return q_wait, mount_configuration(X_pre, near=q_wait)
+
+
+# [m] the farthest any point of the receiver's open gripper moves between two of its transit's
+# poses that are checked (`transit_poses`): under the thickness of a pad (12 mm), so that no
+# box of it steps over a wall of points.
+TRANSIT_STEP = 0.01
+
+
+def transit_poses(handover: Handover, X_WR: np.ndarray) -> np.ndarray:
+    """(n, 4, 4) the receiver's poses along its transit from where it waits to its pre-grasp for
+    grasp X_WR (`receiver_motion`: a straight line in the mount's q), no two more than
+    TRANSIT_STEP apart at any point of its open gripper, both ends included."""
+    q_wait, q_pre = _transit(handover, X_WR)
+    radius = max(float(np.linalg.norm(np.abs(c) + h)) for _, c, h in gripper_boxes(
+        WSG_MAX_OPENING))  # the farthest corner of its boxes from its origin [m]
+    d = q_pre - q_wait
+    reach = float(np.linalg.norm(d[:3])) + radius * float(np.abs(d[3:]).sum())
+    s = np.linspace(0.0, 1.0, 2 + int(math.ceil(reach / TRANSIT_STEP)))
+    return np.array([mount_pose(q_wait + v * d) for v in s])
+
+
+def transit_cut(handover: Handover, X_WR: np.ndarray, points_W: np.ndarray, k: int) -> float:
+    """[m] how deep the points points_W (n, 3) cut the receiver's open gripper (its housing and
+    pads, `gripper_boxes`) anywhere along its transit to the pre-grasp of grasp X_WR (the k-th
+    deepest point at each pose, robust to k − 1 stray points; 0: clear)."""
+    points_W = np.asarray(points_W, float).reshape(-1, 3)
+    cuts = deepest_cuts(transit_poses(handover, X_WR), points_W, gripper_boxes(WSG_MAX_OPENING),
+                        k)
+    return float(cuts.max()) if len(cuts) else 0.0
+
+
 def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float,
                     t_earliest: float = 0.0, X_WG_robot: np.ndarray | None = None
                     ) -> HandoverMotion:
@@ -591,10 +658,7 @@ def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float
     pose then (on the lying can, bottle and glass passes of S_GRASP the receiver, there early,
     was struck by links 5-7 with 130-830 N)."""
     c = handover.config
-    q_wait = mount_configuration(handover.X_WR_wait)
-    X_pre = np.array(grasp.X_WR, float)
-    X_pre[:3, 3] -= c.approach * X_pre[:3, 1]
-    q_pre = mount_configuration(X_pre, near=q_wait)
+    q_wait, q_pre = _transit(handover, grasp.X_WR)
     q_grasp = mount_configuration(grasp.X_WR, near=q_pre)
     move = _duration(q_wait, q_pre, c.speed, c.turn_speed, 1.0)
     t_start = max(t_earliest, t_arrive)
