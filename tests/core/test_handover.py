@@ -440,21 +440,31 @@ def test_judge_pass_reports_the_part_the_receiver_holds():
 
 def test_a_container_is_not_squeezed_end_to_end_along_gravity_by_the_receiver():
     """The bar seen as a container standing on its axis (not a tool, its frame's z vertical): the
-    turns of the top grasps that would close along the vertical, its axis, are not taken; as a
-    tool the same turns are allowed (a handle squeezed from above and below)."""
+    turns of the top grasps on its body (here its middle) that would close along the vertical,
+    its axis, are not taken; as a tool the same turns are allowed (a handle squeezed from above
+    and below), and so they are on a container's handle (a pan's, standing out sideways: the pads
+    across the handle alone)."""
     import dataclasses
 
     container = dataclasses.replace(bar(0.3), is_tool=False)
-    kept = []
-    for target in (container, bar(0.3)):
+    body = candidates([-0.07, -0.10])
+    body = dataclasses.replace(body, parts=np.full(2, PART_LABELS.index("middle")))
+    kept = {}
+    for name, target, cands, parts in (
+            ("container body", container, body, {"middle": 1.0}),
+            ("container handle", container, candidates([-0.07, -0.10]), {"handle": 1.0}),
+            ("tool handle", bar(0.3), candidates([-0.07, -0.10]), {"handle": 1.0})):
         grasp, why = choose_receiver_grasp(
-            candidates([-0.07, -0.10]), target=target, X_WO=target.X_WO,
-            X_WO_handover=target.X_WO, X_WG_robot=top_grasp(0.07, 0.3),
-            receiver_parts={"handle": 0.9, "usable_area": 0.1}, handover=HANDOVER,
+            cands, target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
+            X_WG_robot=top_grasp(0.07, 0.3), receiver_parts=parts, handover=HANDOVER,
             table_z=0.0, retreat=0.1)
         assert grasp is not None, why
-        kept.append(abs(grasp.X_WR[2, 0]))
-    assert kept[0] < 0.5  # the container's receiver closes across, not along, the vertical
+        kept[name] = grasp.X_WR
+    # The container's receiver closes across, not along, the vertical on its body ...
+    assert abs(kept["container body"][2, 0]) < 0.5
+    # ... and as on a tool's on its handle, where it takes the vertical closing.
+    assert np.allclose(kept["container handle"], kept["tool handle"])
+    assert abs(kept["tool handle"][2, 0]) > 0.9
 
 
 def test_the_receiver_is_refused_what_the_robot_would_be_refused(monkeypatch):

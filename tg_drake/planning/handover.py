@@ -375,12 +375,14 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     # its axis (a glass from rim to base) holds it on its lower pad, and when the robot lets go it
     # drops by the error of the perceived extent's centre between the pads (15-57 mm in S_ROBOT's
     # glass hand-overs). "Along": closer to it than to square (45°). (A tool's frame z is not its
-    # axis; its handle is squeezed from above and below on purpose: `turned_about_width`.)
+    # axis; its handle is squeezed from above and below on purpose: `turned_about_width`. So is a
+    # container's handle — a pan's, standing out sideways — the pads across the handle alone.)
     if not target.is_tool:
         x_R = X_WR[:, :3, 0]
         z_O = np.asarray(X_WO_handover, float)[:3, 2]
         square = math.cos(math.radians(45.0))
-        end_to_end = (np.abs(x_R[:, 2]) > square) & (np.abs(x_R @ z_O) > square)
+        body = np.array([names[k] != "handle" for k in on_part], bool)
+        end_to_end = (np.abs(x_R[:, 2]) > square) & (np.abs(x_R @ z_O) > square) & body
         X_WR, on_part = X_WR[~end_to_end], on_part[~end_to_end]
         if not len(X_WR):
             return None, (f"hand-over: every receiver grasp on {wanted} would squeeze the object "
