@@ -504,22 +504,26 @@ def test_the_receiver_is_refused_what_the_robot_would_be_refused(monkeypatch):
     assert grasp is not None, why
 
 
-def test_a_receiver_whose_way_in_crosses_the_robots_gripper_is_refused():
-    """Waiting on the +x side (yaw 180°: it moves along −x), the receiver would pass through the
-    robot's housing (x 0.045 … 0.095 m) on its way to a grasp at x 0.018 m; from the −x side
-    (yaw 0°) the same grasp is taken. The transit's poses run from where it waits to the
-    pre-grasp, no point of its open gripper moving more than TRANSIT_STEP between two."""
+def test_a_receiver_whose_way_in_crosses_the_robots_arm_is_refused():
+    """An arm link stands as a wall of points at x 0.15 m (y ±0.1 m, z 0.35 … 0.8 m): waiting on
+    the +x side (yaw 180°: it moves along −x) the receiver would pass through it on its way to a
+    grasp at x 0.018 m; from the −x side (yaw 0°) the same grasp is taken. The transit's poses
+    run from where it waits to the pre-grasp, no point of its open gripper moving more than
+    TRANSIT_STEP between two."""
     from tg_drake.grasping.feasibility import gripper_boxes
     from tg_drake.planning.handover import TRANSIT_STEP, transit_poses
 
     target = bar(0.3)
+    g = np.arange(-0.1, 0.1001, 0.005)
+    h = np.arange(0.35, 0.8001, 0.005)
+    wall = np.stack(np.meshgrid([0.15], g, h, indexing="ij"), axis=-1).reshape(-1, 3)
     outcome = {}
     for yaw in (180.0, 0.0):
         handover = Handover(ReceiverConfig(xy=[0.0, 0.0], height=0.3, yaw=yaw), np.eye(4))
         outcome[yaw] = choose_receiver_grasp(
             candidates([0.018]), target=target, X_WO=target.X_WO, X_WO_handover=target.X_WO,
             X_WG_robot=top_grasp(0.07, 0.3), receiver_parts={"usable_area": 1.0},
-            handover=handover, table_z=0.0, retreat=0.1)
+            handover=handover, table_z=0.0, retreat=0.1, arm_p_W=wall)
         X = transit_poses(handover, top_grasp(0.018, 0.3))
         assert np.allclose(X[0], handover.X_WR_wait)
         pre = top_grasp(0.018, 0.3)
@@ -530,5 +534,5 @@ def test_a_receiver_whose_way_in_crosses_the_robots_gripper_is_refused():
         p = np.einsum("nij,kj->nki", X[:, :3, :3], corners) + X[:, None, :3, 3]
         assert np.linalg.norm(np.diff(p, axis=0), axis=2).max() <= TRANSIT_STEP + 1e-9
     grasp, why = outcome[180.0]
-    assert grasp is None and "would cross the robot's arm or gripper" in why
+    assert grasp is None and "would cross the robot's arm" in why
     assert outcome[0.0][0] is not None, outcome[0.0][1]

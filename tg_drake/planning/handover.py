@@ -446,16 +446,13 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     # Poses whose contact mechanics hold the weight (margin ≥ 1) first, then by score.
     margin = np.array([h.margin >= 1.0 for h in f.holds], bool) & ok
     # The first of them whose transit, from where the receiver waits to its pre-grasp, keeps
-    # clear of the robot's arm and gripper (holding, its pads at the grip width: the robot
-    # stands still at the hand-over while the receiver comes) and of the object: a receiver
-    # passing through the arm strikes it and knocks the object out of the robot's hand.
+    # clear of the robot's arm (links 1-7: the robot stands still at the hand-over while the
+    # receiver comes) and of the object: a receiver passing through the arm strikes it, and the
+    # arm, held by its joints' controllers, gives way and lets the object go. (Near the robot's
+    # gripper the receiver's approach and grasp are checked above; on the way a graze of its
+    # housing was seen to do no harm.)
     target_p_W = np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3]
-    grip = grip_width(X_WG_robot, target_p_W, WSG_MAX_OPENING)
-    X_WG_robot = np.asarray(X_WG_robot, float)
-    robot_G = np.concatenate([_box_grid(centre, half + config.clearance, 0.005)
-                              for _, centre, half in gripper_boxes(max(grip, 0.0))])
-    obstacles = np.concatenate([robot_G @ X_WG_robot[:3, :3].T + X_WG_robot[:3, 3], arm,
-                                target_p_W])
+    obstacles = np.concatenate([arm, target_p_W])
     best, blocked = None, 0
     for j in np.argsort(-(score + 2.0 * margin), kind="stable"):  # scores lie in [0, 1]
         if not ok[j]:
@@ -468,7 +465,7 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     if best is None:
         return None, (f"hand-over: the receiver's way from where it waits to each of its "
                       f"{blocked} grasps on {wanted} clear at the hand-over would cross the "
-                      f"robot's arm or gripper or the object")
+                      f"robot's arm or the object")
     i = int(idx[best])
     return ReceiverGrasp(X_WR[keep][best], names[i], i, float(p_recv[i]), float(p_local[best]),
                          float(f.p_hold[best]), float(score[best]),
