@@ -325,7 +325,11 @@ def _collisions(X_WG: np.ndarray, *, others_p_W: np.ndarray, table_z: float, app
     for i, sweep in enumerate(sweeps):
         for j, (name, c, h) in enumerate(sweep, start=len(boxes)):
             names[j], centre[i, j], half[i, j], present[i, j] = name, c, h, True
-    p_G = _in_G(X_WG, np.asarray(others_p_W, float).reshape(-1, 3))
+    p_W = np.asarray(others_p_W, float).reshape(-1, 3)
+    if len(p_W) and len(X_WG):  # only points within a box's reach of some pose can cut one
+        reach = float(np.linalg.norm(np.abs(centre) + half, axis=2)[present].max())
+        p_W = p_W[np.isfinite(cKDTree(X_WG[:, :3, 3]).query(p_W, distance_upper_bound=reach)[0])]
+    p_G = _in_G(X_WG, p_W)
     cuts = _cuts(p_G, centre, half, config.min_points, present)
     lowest = np.where(present[..., None], _box_corners_W(X_WG[:, None], centre, half)[..., 2],
                       np.inf).min(axis=(1, 2))

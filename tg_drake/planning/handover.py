@@ -51,6 +51,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from tg_drake.errors import ScenarioError
 from tg_drake.grasping.feasibility import (
@@ -642,9 +643,14 @@ def transit_cut(handover: Handover, X_WR: np.ndarray, points_W: np.ndarray, k: i
     pads, `gripper_boxes`) anywhere along its transit to the pre-grasp of grasp X_WR (the k-th
     deepest point at each pose, robust to k − 1 stray points; 0: clear)."""
     points_W = np.asarray(points_W, float).reshape(-1, 3)
-    cuts = deepest_cuts(transit_poses(handover, X_WR), points_W, gripper_boxes(WSG_MAX_OPENING),
-                        k)
-    return float(cuts.max()) if len(cuts) else 0.0
+    poses = transit_poses(handover, X_WR)
+    boxes = gripper_boxes(WSG_MAX_OPENING)
+    # Only the points within the gripper's reach of some pose's origin can be inside a box.
+    radius = max(float(np.linalg.norm(np.abs(c) + h)) for _, c, h in boxes)
+    near = np.isfinite(cKDTree(poses[:, :3, 3]).query(points_W, distance_upper_bound=radius)[0])
+    if near.sum() < k:
+        return 0.0
+    return float(deepest_cuts(poses, points_W[near], boxes, k).max())
 
 
 def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float,
