@@ -26,6 +26,7 @@ The station has a receiver when the scenario's task is pass or it gives a `recei
 from __future__ import annotations
 
 import numpy as np
+import open3d as o3d
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import (
@@ -45,6 +46,7 @@ from pydrake.multibody.tree import (
 )
 from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import MatrixGain
+from scipy.spatial import cKDTree
 
 from tg_drake.planning.handover import (
     Handover,
@@ -209,9 +211,6 @@ def seen_correction(C: np.ndarray, X_expected: np.ndarray, p_O: np.ndarray, n_O:
     distances), else C. A person sees the shape, not the frame: a glass rolled about its axis in
     the robot's hand looks as it did, and following the frame's roll would swing the receiver's
     way in about the object (into the robot's arm); a cup turned so is followed by its handle."""
-    import open3d as o3d
-    from scipy.spatial import cKDTree
-
     p_O, n_O = np.asarray(p_O, float), np.asarray(n_O, float)
     X_expected, C = np.asarray(X_expected, float), np.asarray(C, float)
     X_actual = C @ X_expected
