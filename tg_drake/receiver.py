@@ -246,10 +246,11 @@ class ReceiverDriver(LeafSystem):
         - receiver.position
 
     The receiver stands for the person who takes the object, and like a person it sees where the
-    object is: with ``body_poses`` connected, every `period` seconds until its straight approach
-    begins (from the robot's arrival at the hand-over pose, `HandoverMotion.t_arrive`, for its
-    `look` seconds), it compares the object's simulated pose with where the plan carries it
-    (rigidly from where it stood, with the robot's gripper: `HandoverMotion.X_WG_robot` ·
+    object is: with ``body_poses`` connected, every `period` seconds from the robot's arrival at
+    the hand-over pose (`HandoverMotion.t_arrive`) until its pads begin to close (the end of its
+    straight approach: a heavy tool still turning slowly in the robot's grip is followed as the
+    receiver reaches for it), it compares the object's simulated pose with where the plan carries
+    it (rigidly from where it stood, with the robot's gripper: `HandoverMotion.X_WG_robot` ·
     `Plan.X_WG_grasp`⁻¹ · the pose at the plan's start) and moves its motion from then on with the
     difference (an object that shifted in the robot's hand as the pads closed); then the
     correction is kept. Given the object's `surface` (points and outward normals in its frame),
@@ -282,7 +283,7 @@ class ReceiverDriver(LeafSystem):
             return
         motion, t = self._motion(context)
         X_start, C = context.get_abstract_state(0).get_value()
-        if motion is None or t >= motion.times[3]:  # no plan yet, or approaching: keep
+        if motion is None or t >= motion.times[4]:  # no plan yet, or closing: keep
             return
         if X_start is not None and t < motion.t_arrive:  # carrying: nothing to compare yet
             return
