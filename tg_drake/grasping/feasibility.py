@@ -702,6 +702,25 @@ class Feasibility:
     collisions: tuple[Collision, ...]
 
 
+def collision_reason(c: Collision) -> str:
+    """Why a pose that collides (`Collision`, not free) is infeasible."""
+    if c.what == "other object":
+        return f"{COLLISION}the {c.box} would cut another object by {c.depth * 1000:.1f} mm"
+    return (f"{COLLISION}the gripper would reach {-c.table_clearance * 1000:.1f} mm under the "
+            "table top")
+
+
+def others_hit(X_WG: np.ndarray, *, others_p_W: np.ndarray, approach: float,
+               config: FeasibilityConfig, closed_widths) -> list[str]:
+    """Per pose X_WG (M, 4, 4): why the open gripper swept along its approach or its pads closing
+    to closed_widths[i] [m] (None: not checked) would cut the points others_p_W ("" if they
+    would not) — `grasp_feasibility`'s collision with other objects, the table left out."""
+    hits = _collisions(np.asarray(X_WG, float).reshape(-1, 4, 4), others_p_W=others_p_W,
+                       table_z=-np.inf, approach=approach, config=config,
+                       closed_widths=closed_widths)
+    return [collision_reason(c) if c.what == "other object" else "" for c in hits]
+
+
 def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: np.ndarray,
                       table_z: float, approach: float, category: dict[str, float] | None,
                       config: FeasibilityConfig, model: HoldModel | None = None) -> Feasibility:
@@ -727,10 +746,7 @@ def grasp_feasibility(X_WG: np.ndarray, *, target_p_W: np.ndarray, others_p_W: n
     p, reasons = [], []
     for h, c in zip(holds, hits, strict=True):
         if not c.free:
-            reasons.append(f"{COLLISION}the {c.box} would cut another object by "
-                           f"{c.depth * 1000:.1f} mm" if c.what == "other object" else
-                           f"{COLLISION}the gripper would reach {-c.table_clearance * 1000:.1f} "
-                           "mm under the table top")
+            reasons.append(collision_reason(c))
             p.append(0.0)
             continue
         if h.n_points < 2:

@@ -46,7 +46,6 @@ Arrays in, arrays out: no Drake.
 
 
 
-import hashlib
 import math
 from dataclasses import dataclass, field
 
@@ -61,6 +60,7 @@ from tg_drake.grasping.feasibility import (
     grasp_feasibility,
     grip_width,
     gripper_boxes,
+    others_hit,
 )
 from tg_drake.grasping.pads import (
     GRASP_DEPTH,  # [m] the grasp point along +y_G
@@ -404,17 +404,14 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     keep = keep[np.argsort(-prior, kind="stable")[:config.max_grasps]]
     X_OG = np.linalg.inv(np.asarray(X_WO_handover, float)) @ np.asarray(X_WG_robot, float)
     arm = np.zeros((0, 3)) if arm_p_W is None else np.asarray(arm_p_W, float).reshape(-1, 3)
-    X_OW = np.linalg.inv(np.asarray(X_WO_handover, float))
-    arm_O = np.round(arm @ X_OW[:3, :3].T + X_OW[:3, 3], 3)  # the arm as seen from the object
     key = (np.round(X_OG, 6).tobytes(), round(float(X_WO_handover[2, 3]) - table_z, 6),
-           keep.tobytes(), hashlib.sha1(arm_O.tobytes()).hexdigest())
+           keep.tobytes())
     if cache is None or key not in cache:
         carried_target = moved_rigidly(target, moved)
         target_p_W = carried_target.p_W
         grip = grip_width(X_WG_robot, target_p_W, WSG_MAX_OPENING)
-        robot = np.concatenate([robot_gripper_points(
-            X_WG_robot, retreat=retreat, closed_width=grip,
-            grow=config.clearance + feasibility.point_tolerance), arm])
+        robot = robot_gripper_points(X_WG_robot, retreat=retreat, closed_width=grip,
+                                     grow=config.clearance + feasibility.point_tolerance)
         f = grasp_feasibility(X_WR[keep], target_p_W=target_p_W, others_p_W=robot,
                               table_z=table_z, approach=config.approach, category=category,
                               config=feasibility)
@@ -435,6 +432,17 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
             cache[key] = (f, reasons)
     else:
         f, reasons = cache[key]
+    # The robot's arm, which is where it is for this hand-over pose alone (the rest above is
+    # the same for every pose of the object, the robot's gripper and the receiver's turned
+    # together about the vertical: the cache's key), clear of the gripper as the rest is.
+    free = [j for j, r in enumerate(reasons) if not r]
+    if len(arm) and free:
+        reasons = list(reasons)
+        hits = others_hit(X_WR[keep[free]], others_p_W=arm, approach=config.approach,
+                          config=feasibility, closed_widths=[
+                              f.holds[j].width if f.holds[j].n_points else None for j in free])
+        for j, why in zip(free, hits, strict=True):
+            reasons[j] = why
     ok = np.array([not r for r in reasons], bool)
     if not ok.any():
         first = next((r for r in reasons if r), "")
