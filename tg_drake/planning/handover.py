@@ -418,7 +418,7 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
         # The object hangs in the robot's grip: a receiver whose housing or open pads, coming
         # in along its approach, cut it would push it round in that grip (a gripper on an object
         # on the table may push it onto the table: the hold model weighs that there, not here).
-        # Then the geometric refusals of the robot's own grasps (pads.geometric_refusal), but
+        # Then the geometric refusals of the robot's own grasps (pads.geometric_refusal), less
         # those of an object on the table: fingers closing along a long part, too little of the
         # object between the pads, a step under them, a weight that would turn it in them.
         centroid = target_p_W.mean(axis=0) if len(target_p_W) else None
