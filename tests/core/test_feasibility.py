@@ -271,3 +271,28 @@ def test_why_no_pose_counts_each_favoured_parts_refusals_by_class():
     assert why_no_pose(mostly_zero, {"handle": 0.8}) == (
         "handle (P(part | task) 0.80): 3 poses, none feasible — scored 0 2, would not hold 1 "
         "(e.g. would not hold: the lever)")
+
+
+def test_deepest_cuts_and_others_hit_measure_how_deep_points_enter_the_housing():
+    """A slab of points 4 mm inside the housing's back face (y_G = −0.0213 − 0.03625 m), at the
+    identity pose and at one 1 m away: the deepest cut is 4 mm there, 0 away; `others_hit` names
+    the housing for the first and nothing for the second."""
+    from tg_drake.grasping.feasibility import (
+        FeasibilityConfig,
+        deepest_cuts,
+        gripper_boxes,
+        others_hit,
+    )
+    from tg_drake.robot import WSG_BODY_CENTRE_G, WSG_BODY_SIZE
+
+    back = WSG_BODY_CENTRE_G[1] - WSG_BODY_SIZE[1] / 2
+    g = np.linspace(-0.02, 0.02, 9)
+    p = np.stack(np.meshgrid(g, [back + 0.004], g, indexing="ij"), axis=-1).reshape(-1, 3)
+    far = np.eye(4)
+    far[:3, 3] = [1.0, 0.0, 0.0]
+    X = np.array([np.eye(4), far])
+    cuts = deepest_cuts(X, p, gripper_boxes(WSG_MAX_OPENING), 3)
+    assert cuts == pytest.approx([0.004, 0.0], abs=1e-9)
+    why = others_hit(X, others_p_W=p, approach=0.0, config=FeasibilityConfig(),
+                     closed_widths=[None, None])
+    assert "housing" in why[0] and "4.0 mm" in why[0] and why[1] == ""
