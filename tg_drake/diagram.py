@@ -48,7 +48,7 @@ from tg_drake.errors import ScenarioError, unknown_name
 from tg_drake.grasping.model import load_model
 from tg_drake.objects import box_centre, get_object, mesh, sample_surface
 from tg_drake.planning.task_motion import dispenser_obstacle, surfaces_in_world, task_placing
-from tg_drake.receiver import ReceiverDriver, handover_of
+from tg_drake.receiver import ReceiverDriver, Surface, handover_of
 from tg_drake.scenario import DepthPerception, PipelineConfig, Scenario, place_surface
 from tg_drake.station import DISPENSER_WALL, Station, add_station, dispenser_frame, placement_pose
 from tg_drake.systems.depth_noise import DepthNoise
@@ -277,8 +277,8 @@ def add_pipeline(builder: DiagramBuilder, *, scenario: Scenario,
                     station.inputs["iiwa.desired_state"])
     builder.Connect(planner.GetOutputPort("wsg.position"), station.inputs["wsg.position"])
     if "receiver.mount" in station.inputs:  # a pass: the receiver follows the plan's hand-over
-        shape = sample_surface(target_placement.id, spacing=RECEIVER_SURFACE_SPACING,
-                               rng=np.random.default_rng(0))[:2]
+        shape = Surface(*sample_surface(target_placement.id, spacing=RECEIVER_SURFACE_SPACING,
+                                        rng=np.random.default_rng(0))[:2])
         receiver = builder.AddNamedSystem("receiver_driver", ReceiverDriver(
             handover_of(scenario),
             object_body=int(station.object_body(target_placement.instance_name).index()),

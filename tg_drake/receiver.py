@@ -201,34 +201,46 @@ def _first_velocity(plant, instance) -> int:
 SEE_MATCH_DISTANCE = 0.02
 
 
-def seen_correction(C: np.ndarray, X_expected: np.ndarray, p_O: np.ndarray, n_O: np.ndarray,
+class Surface:
+    """An object's surface for `seen_correction`: points p_O and outward normals n_O (n, 3) in its
+    frame, and what matching against it needs, made once (Open3D's cloud, a k-d tree)."""
+
+    def __init__(self, p_O: np.ndarray, n_O: np.ndarray):
+        self.p_O, self.n_O = np.asarray(p_O, float), np.asarray(n_O, float)
+        self.cloud = o3d.geometry.PointCloud()
+        self.cloud.points = o3d.utility.Vector3dVector(self.p_O)
+        self.cloud.normals = o3d.utility.Vector3dVector(self.n_O)
+        self.tree = cKDTree(self.p_O)
+
+
+def seen_correction(C: np.ndarray, X_expected: np.ndarray, surface: Surface,
                     tolerance: float) -> np.ndarray:
     """The move (4×4, world) the receiver follows, given the object's true move C (X_WO ·
-    X_expected⁻¹) from where the plan carries it (X_expected) and its surface (points p_O,
-    outward normals n_O, (n, 3), its frame): the smallest move that shows the same shape — an
-    ICP (Open3D, point to plane, from no move) of the surface where it is expected onto where it
-    is — when it matches within `tolerance` [m] (95th percentile of the point-to-plane
-    distances), else C. A person sees the shape, not the frame: a glass rolled about its axis in
-    the robot's hand looks as it did, and following the frame's roll would swing the receiver's
-    way in about the object (into the robot's arm); a cup turned so is followed by its handle."""
-    p_O, n_O = np.asarray(p_O, float), np.asarray(n_O, float)
+    X_expected⁻¹) from where the plan carries it (X_expected) and its `surface`: the smallest
+    move that shows the same shape — an ICP (Open3D, point to plane, from no move) of the surface
+    where it is expected onto where it is — when it matches within `tolerance` [m] (95th
+    percentile of the point-to-plane distances), else C. (Matched in the frame of the object
+    where it is, against the surface as made once: the same move.) A person sees the shape, not
+    the frame: a glass rolled about its axis in the robot's hand looks as it did, and following
+    the frame's roll would swing the receiver's way in about the object (into the robot's arm);
+    a cup turned so is followed by its handle."""
     X_expected, C = np.asarray(X_expected, float), np.asarray(C, float)
     X_actual = C @ X_expected
-    source = p_O @ X_expected[:3, :3].T + X_expected[:3, 3]
-    target = p_O @ X_actual[:3, :3].T + X_actual[:3, 3]
-    normals = n_O @ X_actual[:3, :3].T
-    src, tgt = o3d.geometry.PointCloud(), o3d.geometry.PointCloud()
+    A = np.linalg.inv(X_actual) @ X_expected  # where it is expected, seen from where it is
+    source = surface.p_O @ A[:3, :3].T + A[:3, 3]
+    src = o3d.geometry.PointCloud()
     src.points = o3d.utility.Vector3dVector(source)
-    tgt.points = o3d.utility.Vector3dVector(target)
-    tgt.normals = o3d.utility.Vector3dVector(normals)
     reg = o3d.pipelines.registration
     T = np.asarray(reg.registration_icp(
-        src, tgt, SEE_MATCH_DISTANCE, np.eye(4), reg.TransformationEstimationPointToPlane(),
+        src, surface.cloud, SEE_MATCH_DISTANCE, np.eye(4),
+        reg.TransformationEstimationPointToPlane(),
         reg.ICPConvergenceCriteria(max_iteration=30)).transformation)
     moved = source @ T[:3, :3].T + T[:3, 3]
-    _, i = cKDTree(target).query(moved)
-    gap = np.abs(np.einsum("ij,ij->i", moved - target[i], normals[i]))
-    return T if np.percentile(gap, 95) <= tolerance else C
+    _, i = surface.tree.query(moved)
+    gap = np.abs(np.einsum("ij,ij->i", moved - surface.p_O[i], surface.n_O[i]))
+    if np.percentile(gap, 95) > tolerance:
+        return C
+    return X_actual @ T @ np.linalg.inv(X_actual)
 
 
 class ReceiverDriver(LeafSystem):
@@ -253,13 +265,13 @@ class ReceiverDriver(LeafSystem):
     it (rigidly from where it stood, with the robot's gripper: `HandoverMotion.X_WG_robot` ·
     `Plan.X_WG_grasp`⁻¹ · the pose at the plan's start) and moves its motion from then on with the
     difference (an object that shifted in the robot's hand as the pads closed); then the
-    correction is kept. Given the object's `surface` (points and outward normals in its frame),
-    it follows the smallest move that shows the same shape instead (`seen_correction`). The
-    robot's pipeline never sees it.
+    correction is kept. Given the object's `surface` (`Surface`: points and outward normals in
+    its frame), it follows the smallest move that shows the same shape instead
+    (`seen_correction`). The robot's pipeline never sees it.
     """
 
     def __init__(self, handover: Handover, *, object_body: int | None = None,
-                 period: float = 0.05, surface: tuple[np.ndarray, np.ndarray] | None = None):
+                 period: float = 0.05, surface: Surface | None = None):
         super().__init__()
         self._q_wait = mount_configuration(handover.X_WR_wait)
         self._object = object_body
@@ -295,7 +307,7 @@ class ReceiverDriver(LeafSystem):
         expected = motion.X_WG_robot @ np.linalg.inv(np.asarray(plan.X_WG_grasp)) @ X_start
         C = X_WO @ np.linalg.inv(expected)
         if self._surface is not None:
-            C = seen_correction(C, expected, *self._surface, self._see)
+            C = seen_correction(C, expected, self._surface, self._see)
         state.get_mutable_abstract_state(0).set_value((X_start, C))
 
     def _motion(self, context):

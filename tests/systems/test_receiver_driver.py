@@ -16,7 +16,7 @@ from tg_drake.planning.handover import (
     mount_pose,
     receiver_motion,
 )
-from tg_drake.receiver import ReceiverDriver, seen_correction
+from tg_drake.receiver import ReceiverDriver, Surface, seen_correction
 from tg_drake.systems.plan_messages import PlanState, PlanStatus
 
 
@@ -61,7 +61,7 @@ def test_a_roll_the_receiver_cannot_see_is_not_followed_a_shift_is():
     expected = pose()
     # Rolled 50° about its axis and shifted 8 mm: the same shape 8 mm off.
     C = pose(50.0, (0.0, 0.008, 0.0)) @ np.linalg.inv(expected)
-    T = seen_correction(C, expected, p, n, 0.003)
+    T = seen_correction(C, expected, Surface(p, n), 0.003)
     assert np.allclose(T[:3, 3] + T[:3, :3] @ [0.6, 0, 0.3] - [0.6, 0, 0.3], [0, 0.008, 0],
                        atol=0.001)
     angle = math.degrees(math.acos(np.clip((np.trace(T[:3, :3]) - 1) / 2, -1, 1)))
@@ -74,7 +74,7 @@ def test_a_turn_that_moves_a_handle_is_followed_by_the_frame():
     p, n = cylinder(handle=True)
     expected = pose()
     C = pose(50.0) @ np.linalg.inv(expected)
-    assert np.allclose(seen_correction(C, expected, p, n, 0.003), C)
+    assert np.allclose(seen_correction(C, expected, Surface(p, n), 0.003), C)
 
 
 HANDOVER = Handover(ReceiverConfig(xy=[0.6, 0.0], height=0.3, yaw=180.0), np.eye(4))
@@ -106,13 +106,13 @@ def _run(X_after: np.ndarray, surface) -> np.ndarray:
 
 
 def test_the_receiver_driver_follows_a_shifted_object_in_a_small_diagram():
-    p, n = cylinder()
-    plain = _run(pose(), (p, n))
-    shifted = _run(pose(0.0, (0.0, 0.01, 0.0)), (p, n))
+    surface = Surface(*cylinder())
+    plain = _run(pose(), surface)
+    shifted = _run(pose(0.0, (0.0, 0.01, 0.0)), surface)
     assert shifted[:3, 3] - plain[:3, 3] == pytest.approx([0.0, 0.01, 0.0], abs=1e-3)
     # Rolled 60° about its axis (the same shape): with the surface it stays; by the frame alone
     # it swings its grasp round the object's axis (60° from above onto the side).
-    rolled = _run(pose(60.0), (p, n))
+    rolled = _run(pose(60.0), surface)
     assert np.allclose(rolled, plain, atol=2e-3)
     swung = _run(pose(60.0), None)
     assert not np.allclose(swung[:3, 1], plain[:3, 1], atol=0.1)

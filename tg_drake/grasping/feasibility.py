@@ -261,14 +261,28 @@ def penetration(X_WG: np.ndarray, p_W: np.ndarray, boxes, k: int) -> dict[str, f
                         np.array([h for _, _, h in boxes]), k)[0])
 
 
+def boxes_reach(centre: np.ndarray, half: np.ndarray) -> float:
+    """[m] the farthest corner of boxes (centres, half sizes: (…, 3)) from their frame's
+    origin: no point farther than this from it lies in one."""
+    return float(np.linalg.norm(np.abs(centre) + half, axis=-1).max())
+
+
+def _near_poses(X_WG: np.ndarray, p_W: np.ndarray, reach: float) -> np.ndarray:
+    """The points p_W (n, 3) within `reach` [m] of some pose's origin (X_WG (M, 4, 4)): the only
+    ones that can lie in a box of that reach (`boxes_reach`) at one of the poses."""
+    if not len(p_W) or not len(X_WG):
+        return p_W
+    return p_W[np.isfinite(cKDTree(X_WG[:, :3, 3]).query(p_W, distance_upper_bound=reach)[0])]
+
+
 def deepest_cuts(X_WG: np.ndarray, p_W: np.ndarray, boxes, k: int) -> np.ndarray:
     """(M,) how deep [m] the points p_W (n, 3) cut the deepest of the gripper's `boxes` (name,
     centre, half size in G) at each pose X_WG (M, 4, 4): `penetration`'s measure (the k-th
     deepest point of a box; 0 when fewer than k points are inside), many poses at once."""
     X_WG = np.asarray(X_WG, float).reshape(-1, 4, 4)
-    p_W = np.asarray(p_W, float).reshape(-1, 3)
     centre = np.array([c for _, c, _ in boxes])
     half = np.array([h for _, _, h in boxes])
+    p_W = _near_poses(X_WG, np.asarray(p_W, float).reshape(-1, 3), boxes_reach(centre, half))
     step = max(1, _BATCH_POINTS // max(len(p_W), 1))  # poses × points held at once
     return np.concatenate([_cuts(_in_G(X_WG[i:i + step], p_W), centre, half, k).max(axis=1)
                            for i in range(0, len(X_WG), step)]) if len(X_WG) else np.zeros(0)
@@ -325,10 +339,8 @@ def _collisions(X_WG: np.ndarray, *, others_p_W: np.ndarray, table_z: float, app
     for i, sweep in enumerate(sweeps):
         for j, (name, c, h) in enumerate(sweep, start=len(boxes)):
             names[j], centre[i, j], half[i, j], present[i, j] = name, c, h, True
-    p_W = np.asarray(others_p_W, float).reshape(-1, 3)
-    if len(p_W) and len(X_WG):  # only points within a box's reach of some pose can cut one
-        reach = float(np.linalg.norm(np.abs(centre) + half, axis=2)[present].max())
-        p_W = p_W[np.isfinite(cKDTree(X_WG[:, :3, 3]).query(p_W, distance_upper_bound=reach)[0])]
+    p_W = _near_poses(X_WG, np.asarray(others_p_W, float).reshape(-1, 3),
+                      boxes_reach(centre[present], half[present]))
     p_G = _in_G(X_WG, p_W)
     cuts = _cuts(p_G, centre, half, config.min_points, present)
     lowest = np.where(present[..., None], _box_corners_W(X_WG[:, None], centre, half)[..., 2],

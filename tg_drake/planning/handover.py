@@ -50,11 +50,11 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from tg_drake.errors import ScenarioError
 from tg_drake.grasping.feasibility import (
     FeasibilityConfig,
+    boxes_reach,
     closing_sweep,
     deepest_cuts,
     grasp_feasibility,
@@ -406,9 +406,9 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     arm = np.zeros((0, 3)) if arm_p_W is None else np.asarray(arm_p_W, float).reshape(-1, 3)
     key = (np.round(X_OG, 6).tobytes(), round(float(X_WO_handover[2, 3]) - table_z, 6),
            keep.tobytes())
+    target_p_W = np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3]
     if cache is None or key not in cache:
         carried_target = moved_rigidly(target, moved)
-        target_p_W = carried_target.p_W
         grip = grip_width(X_WG_robot, target_p_W, WSG_MAX_OPENING)
         robot = robot_gripper_points(X_WG_robot, retreat=retreat, closed_width=grip,
                                      grow=config.clearance + feasibility.point_tolerance)
@@ -460,7 +460,6 @@ def choose_receiver_grasp(candidates: GraspCandidates, *, target: ObjectDescript
     # arm, held by its joints' controllers, gives way and lets the object go. (Near the robot's
     # gripper the receiver's approach and grasp are checked above; on the way a graze of its
     # housing was seen to do no harm.)
-    target_p_W = np.asarray(target.p_W, float) @ moved[:3, :3].T + moved[:3, 3]
     obstacles = np.concatenate([arm, target_p_W])
     best, blocked = None, 0
     for j in np.argsort(-(score + 2.0 * margin), kind="stable"):  # scores lie in [0, 1]
@@ -638,8 +637,8 @@ def transit_poses(handover: Handover, X_WR: np.ndarray) -> np.ndarray:
     grasp X_WR (`receiver_motion`: a straight line in the mount's q), no two more than
     TRANSIT_STEP apart at any point of its open gripper, both ends included."""
     q_wait, q_pre = _transit(handover, X_WR)
-    radius = max(float(np.linalg.norm(np.abs(c) + h)) for _, c, h in gripper_boxes(
-        WSG_MAX_OPENING))  # the farthest corner of its boxes from its origin [m]
+    boxes = gripper_boxes(WSG_MAX_OPENING)
+    radius = boxes_reach(np.array([c for _, c, _ in boxes]), np.array([h for _, _, h in boxes]))
     d = q_pre - q_wait
     reach = float(np.linalg.norm(d[:3])) + radius * float(np.abs(d[3:]).sum())
     s = np.linspace(0.0, 1.0, 2 + int(math.ceil(reach / TRANSIT_STEP)))
@@ -650,15 +649,9 @@ def transit_cut(handover: Handover, X_WR: np.ndarray, points_W: np.ndarray, k: i
     """[m] how deep the points points_W (n, 3) cut the receiver's open gripper (its housing and
     pads, `gripper_boxes`) anywhere along its transit to the pre-grasp of grasp X_WR (the k-th
     deepest point at each pose, robust to k − 1 stray points; 0: clear)."""
-    points_W = np.asarray(points_W, float).reshape(-1, 3)
-    poses = transit_poses(handover, X_WR)
-    boxes = gripper_boxes(WSG_MAX_OPENING)
-    # Only the points within the gripper's reach of some pose's origin can be inside a box.
-    radius = max(float(np.linalg.norm(np.abs(c) + h)) for _, c, h in boxes)
-    near = np.isfinite(cKDTree(poses[:, :3, 3]).query(points_W, distance_upper_bound=radius)[0])
-    if near.sum() < k:
-        return 0.0
-    return float(deepest_cuts(poses, points_W[near], boxes, k).max())
+    cuts = deepest_cuts(transit_poses(handover, X_WR), points_W, gripper_boxes(WSG_MAX_OPENING),
+                        k)
+    return float(cuts.max()) if len(cuts) else 0.0
 
 
 def receiver_motion(handover: Handover, grasp: ReceiverGrasp, *, t_arrive: float,
