@@ -85,7 +85,7 @@ def add_receiver(plant: MultibodyPlant, parser, scenario) -> ModelInstanceIndex:
     handover = handover_of(scenario)
     config = handover.config
     added = ProcessModelDirectives(ModelDirectives(directives=[ModelDirective(add_model=AddModel(
-        name=RECEIVER, file="package://tg_drake_models/wsg_50/wsg_50.sdf",
+        name=RECEIVER, file="package://tg_drake_models/wsg_50/wsg_50.urdf",
         default_joint_positions={n: [q] for n, q in zip(WSG_FINGER_JOINTS, WSG_OPEN_POSITIONS,
                                                         strict=True)}))]), parser)
     instance = added[0].model_instance

@@ -45,7 +45,7 @@ def default_directives() -> list[ModelDirective]:
                                                             strict=True)})),
         ModelDirective(add_weld=AddWeld(parent="world", child="iiwa::iiwa_link_0")),
         ModelDirective(add_model=AddModel(
-            name="wsg", file="package://tg_drake_models/wsg_50/wsg_50.sdf",
+            name="wsg", file="package://tg_drake_models/wsg_50/wsg_50.urdf",
             default_joint_positions={n: [q] for n, q in zip(WSG_FINGER_JOINTS,
                                                             WSG_OPEN_POSITIONS, strict=True)})),
         ModelDirective(add_weld=AddWeld(parent="iiwa::iiwa_link_7", child="wsg::body",

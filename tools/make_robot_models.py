@@ -152,84 +152,87 @@ def _box_inertia(mass, size):
     return (mass * (y * y + z * z) / 12, mass * (x * x + z * z) / 12, mass * (x * x + y * y) / 12)
 
 
-def _sdf_inertial(mass, size, pose="0 0 0 0 0 0") -> str:
-    ixx, iyy, izz = _box_inertia(mass, size)
-    return (f"      <inertial>\n        <pose>{pose}</pose>\n        <mass>{mass}</mass>\n"
-            f"        <inertia><ixx>{ixx:.6g}</ixx><ixy>0</ixy><ixz>0</ixz><iyy>{iyy:.6g}</iyy>"
-            f"<iyz>0</iyz><izz>{izz:.6g}</izz></inertia>\n      </inertial>\n")
+def _inertia_6g(mass, size) -> tuple:
+    """A box's principal moments [kg·m²], written to 6 significant digits."""
+    return tuple(float(f"{v:.6g}") for v in _box_inertia(mass, size))
 
 
-def _compliant(h) -> str:
-    return ("          <drake:proximity_properties>\n"
-            "            <drake:compliant_hydroelastic/>\n"
-            f"            <drake:hydroelastic_modulus>{h['modulus']:.6g}"
-            "</drake:hydroelastic_modulus>\n"
-            f"            <drake:mesh_resolution_hint>{h['resolution']}"
-            "</drake:mesh_resolution_hint>\n"
-            f"            <drake:hunt_crossley_dissipation>{h['dissipation']}"
-            "</drake:hunt_crossley_dissipation>\n"
-            f"            <drake:mu_dynamic>{h['mu']}</drake:mu_dynamic>\n"
-            f"            <drake:mu_static>{h['mu']}</drake:mu_static>\n"
-            "          </drake:proximity_properties>\n")
+def _compliant_urdf(h) -> str:
+    """A compliant-hydroelastic collision's properties (Drake's URDF form: values as
+    attributes)."""
+    return ("      <drake:proximity_properties>\n"
+            "        <drake:compliant_hydroelastic/>\n"
+            f'        <drake:hydroelastic_modulus value="{h["modulus"]:.6g}"/>\n'
+            f'        <drake:mesh_resolution_hint value="{h["resolution"]}"/>\n'
+            f'        <drake:hunt_crossley_dissipation value="{h["dissipation"]}"/>\n'
+            f'        <drake:mu_dynamic value="{h["mu"]}"/>\n'
+            f'        <drake:mu_static value="{h["mu"]}"/>\n'
+            "      </drake:proximity_properties>\n")
 
 
-def wsg_sdf() -> str:
-    bx, by, bz = WSG_BODY_SIZE
-    px, py, pz = WSG_PAD_SIZE
-    fingers = []
+def wsg_urdf() -> str:
+    """The WSG 50 in URDF: Drake parses a URDF file in well under a millisecond, the same model
+    as an SDFormat file in about 26 ms (libsdformat's file loading), and the planner builds an
+    arm plant with the gripper many times per plan."""
+    body_xyz = _f(WSG_BODY_CENTRE_G)
+    out = ['<?xml version="1.0"?>',
+           "<!-- Schunk WSG 50 parallel gripper, written by tools/make_robot_models.py from",
+           "     the figures of tg_drake/robot.py (the WSG 50 data sheet). Frame of `body` (G):",
+           "     fingers close along ±x, the approach direction is +y, the grasp point is",
+           f"     {WSG_PAD_CENTRE_Y} m along +y. Finger pads are plain boxes with",
+           "     compliant-hydroelastic properties. The two prismatic finger joints are the "
+           "model's only",
+           "     actuated joints (pydrake's SchunkWsgPositionController expects exactly that).",
+           "     Do not edit by hand. -->",
+           '<robot name="wsg_50" xmlns:drake="http://drake.mit.edu">',
+           '  <material name="wsg_body"><color rgba="0.7 0.7 0.75 1"/></material>',
+           '  <material name="wsg_pad"><color rgba="0.2 0.2 0.2 1"/></material>',
+           f'  <link name="{WSG_BODY}">',
+           _inertial_urdf(WSG_BODY_MASS, WSG_BODY_CENTRE_G,
+                          _inertia_6g(WSG_BODY_MASS, WSG_BODY_SIZE)).rstrip("\n"),
+           f'    <visual name="body_visual">\n      <origin xyz="{body_xyz}" rpy="0 0 0"/>\n'
+           f'      <geometry><box size="{_f(WSG_BODY_SIZE)}"/></geometry>\n'
+           '      <material name="wsg_body"/>\n    </visual>',
+           f'    <collision name="body_collision">\n      <origin xyz="{body_xyz}" rpy="0 0 0"/>\n'
+           f'      <geometry><box size="{_f(WSG_BODY_SIZE)}"/></geometry>\n    </collision>',
+           "  </link>"]
     for finger, joint, sign, lower, upper in zip(WSG_FINGERS, WSG_FINGER_JOINTS, (-1, 1),
                                                  (-WSG_STROKE, 0.0), (0.0, WSG_STROKE),
                                                  strict=False):
         # The finger frame moves with its joint; the pad's inner face sits at x = q (the joint
         # value), so the opening is q_right − q_left.
-        pad_pose = f"{sign * px / 2:.6g} {WSG_PAD_CENTRE_Y} 0 0 0 0"
-        fingers.append(
-            f'    <link name="{finger}">\n'
-            + _sdf_inertial(WSG_FINGER_MASS, WSG_PAD_SIZE, pad_pose)
-            + f'      <visual name="{finger}_visual">\n        <pose>{pad_pose}</pose>\n'
-            f"        <geometry><box><size>{px} {py} {pz}</size></box></geometry>\n"
-            "        <material><diffuse>0.2 0.2 0.2 1</diffuse></material>\n      </visual>\n"
-            f'      <collision name="{finger}_pad">\n        <pose>{pad_pose}</pose>\n'
-            f"        <geometry><box><size>{px} {py} {pz}</size></box></geometry>\n"
-            + _compliant(PAD_HYDRO)
-            + "      </collision>\n    </link>\n"
-            f'    <joint name="{joint}" type="prismatic">\n'
-            f"      <parent>{WSG_BODY}</parent>\n      <child>{finger}</child>\n"
-            "      <axis>\n        <xyz>1 0 0</xyz>\n"
-            f"        <limit><lower>{lower}</lower><upper>{upper}</upper>"
-            f"<effort>{WSG_FORCE_LIMIT}</effort>"
-            f"<velocity>{WSG_FINGER_VELOCITY}</velocity></limit>\n"
-            "        <dynamics><damping>0</damping></dynamics>\n      </axis>\n    </joint>\n")
-    body_pose = f"{_f(WSG_BODY_CENTRE_G)} 0 0 0"
-    return (
-        '<?xml version="1.0"?>\n'
-        "<!-- Schunk WSG 50 parallel gripper, written by tools/make_robot_models.py from\n"
-        "     the figures of tg_drake/robot.py (the WSG 50 data sheet). Frame of `body` (G):\n"
-        "     fingers close along ±x, the approach direction is +y, the grasp point is\n"
-        f"     {WSG_PAD_CENTRE_Y} m along +y. Finger pads are plain boxes with\n"
-        "     compliant-hydroelastic properties. The two prismatic finger joints are the "
-        "model's only\n"
-        "     actuated joints (pydrake's SchunkWsgPositionController expects exactly that).\n"
-        "     Do not edit by hand. -->\n"
-        '<sdf version="1.9" xmlns:drake="http://drake.mit.edu">\n'
-        '  <model name="wsg_50">\n'
-        f'    <link name="{WSG_BODY}">\n'
-        + _sdf_inertial(WSG_BODY_MASS, WSG_BODY_SIZE, body_pose)
-        + '      <visual name="body_visual">\n'
-        f"        <pose>{body_pose}</pose>\n"
-        f"        <geometry><box><size>{bx} {by} {bz}</size></box></geometry>\n"
-        "        <material><diffuse>0.7 0.7 0.75 1</diffuse></material>\n      </visual>\n"
-        '      <collision name="body_collision">\n'
-        f"        <pose>{body_pose}</pose>\n"
-        f"        <geometry><box><size>{bx} {by} {bz}</size></box></geometry>\n"
-        "      </collision>\n    </link>\n"
-        + "".join(fingers)
-        + "  </model>\n</sdf>\n")
+        pad_xyz = (sign * WSG_PAD_SIZE[0] / 2, WSG_PAD_CENTRE_Y, 0.0)
+        out += [f'  <link name="{finger}">',
+                _inertial_urdf(WSG_FINGER_MASS, pad_xyz,
+                               _inertia_6g(WSG_FINGER_MASS, WSG_PAD_SIZE)).rstrip("\n"),
+                f'    <visual name="{finger}_visual">\n'
+                f'      <origin xyz="{_f(pad_xyz)}" rpy="0 0 0"/>\n'
+                f'      <geometry><box size="{_f(WSG_PAD_SIZE)}"/></geometry>\n'
+                '      <material name="wsg_pad"/>\n    </visual>',
+                f'    <collision name="{finger}_pad">\n'
+                f'      <origin xyz="{_f(pad_xyz)}" rpy="0 0 0"/>\n'
+                f'      <geometry><box size="{_f(WSG_PAD_SIZE)}"/></geometry>\n'
+                + _compliant_urdf(PAD_HYDRO) + "    </collision>",
+                "  </link>",
+                f'  <joint name="{joint}" type="prismatic">\n'
+                f'    <parent link="{WSG_BODY}"/>\n    <child link="{finger}"/>\n'
+                '    <origin xyz="0 0 0" rpy="0 0 0"/>\n    <axis xyz="1 0 0"/>\n'
+                f'    <limit lower="{lower}" upper="{upper}" effort="{WSG_FORCE_LIMIT}" '
+                f'velocity="{WSG_FINGER_VELOCITY}"/>\n'
+                '    <dynamics damping="0"/>\n  </joint>',
+                f'  <transmission name="{joint}_transmission">\n'
+                '    <type>transmission_interface/SimpleTransmission</type>\n'
+                f'    <joint name="{joint}"><hardwareInterface>EffortJointInterface'
+                '</hardwareInterface></joint>\n'
+                f'    <actuator name="{joint}"><mechanicalReduction>1</mechanicalReduction>'
+                '</actuator>\n  </transmission>']
+    out.append("</robot>")
+    return "\n".join(out) + "\n"
 
 
 FILES = {
     "iiwa14/iiwa14.urdf": iiwa_urdf,
-    "wsg_50/wsg_50.sdf": wsg_sdf,
+    "wsg_50/wsg_50.urdf": wsg_urdf,
     "table/table.sdf": table_sdf,
 }
 

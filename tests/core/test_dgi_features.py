@@ -173,17 +173,17 @@ def test_bad_inputs_are_clear_errors():
 
 
 def test_constants_match_the_wsg_model():
-    sdf = ET.fromstring((files("tg_drake_models") / "wsg_50" / "wsg_50.sdf").read_text())
-    links = {link.get("name"): link for link in sdf.iter("link")}
-    joints = {j.get("name"): j for j in sdf.iter("joint")}
+    urdf = ET.fromstring((files("tg_drake_models") / "wsg_50" / "wsg_50.urdf").read_text())
+    links = {link.get("name"): link for link in urdf.findall("link")}
+    joints = {j.get("name"): j for j in urdf.findall("joint")}  # (not a transmission's)
     for side, sign in (("left", -1.0), ("right", 1.0)):
         pad = links[f"{side}_finger"].find("collision")
-        size = np.array(pad.find("geometry/box/size").text.split(), dtype=float)
-        pose = np.array(pad.find("pose").text.split(), dtype=float)
+        size = np.array(pad.find("geometry/box").get("size").split(), dtype=float)
+        pose = np.array(pad.find("origin").get("xyz").split(), dtype=float)
         np.testing.assert_allclose(size, PAD_SIZE)
         assert pose[1] == pytest.approx(PAD_CENTER_Y)
-        limit = joints[f"{side}_finger_sliding_joint"].find("axis/limit")
-        stroke = float(limit.find("upper" if sign > 0 else "lower").text)
+        limit = joints[f"{side}_finger_sliding_joint"].find("limit")
+        stroke = float(limit.get("upper" if sign > 0 else "lower"))
         # The pad's inner face at full stroke: its centre offset minus half its thickness.
         inner_face = stroke + pose[0] - sign * PAD_SIZE[0] / 2
         assert abs(inner_face) == pytest.approx(MAX_OPENING / 2)

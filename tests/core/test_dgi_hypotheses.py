@@ -104,11 +104,12 @@ def test_surface_grasps_approach_against_the_normal():
 
 
 def test_clears_plane_against_the_wsg_boxes():
-    sdf = ET.fromstring((files("tg_drake_models") / "wsg_50" / "wsg_50.sdf").read_text())
-    body = next(c for c in sdf.iter("collision") if c.get("name") == "body_collision")
-    np.testing.assert_allclose(np.array(body.find("geometry/box/size").text.split(), float),
+    urdf = ET.fromstring((files("tg_drake_models") / "wsg_50" / "wsg_50.urdf").read_text())
+    body = next(c for c in urdf.iter("collision") if c.get("name") == "body_collision")
+    np.testing.assert_allclose(np.array(body.find("geometry/box").get("size").split(), float),
                                BODY_BOX[1])
-    np.testing.assert_allclose(np.array(body.find("pose").text.split(), float)[:3], BODY_BOX[0])
+    np.testing.assert_allclose(np.array(body.find("origin").get("xyz").split(), float),
+                               BODY_BOX[0])
     # Top-down grasp (approach −z_W): the lowest point is the open pads' tips at 0.096 m along y_G.
     X = np.eye(4)
     X[:3, :3] = np.column_stack([[1, 0, 0], [0, 0, -1], [0, 1, 0]])

@@ -14,7 +14,7 @@ from tg_drake.models import make_parser
 def test_schunk_wsg_position_controller_drives_our_model_to_a_width():
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.001)
-    wsg = make_parser(plant).AddModels(url="package://tg_drake_models/wsg_50/wsg_50.sdf")[0]
+    wsg = make_parser(plant).AddModels(url="package://tg_drake_models/wsg_50/wsg_50.urdf")[0]
     plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("body", wsg))
     plant.Finalize()
     assert plant.num_actuated_dofs(wsg) == 2  # the controller's requirement

@@ -37,7 +37,7 @@ def finger_offset(coupled: bool) -> float:
     plant, _ = AddMultibodyPlant(MultibodyPlantConfig(
         time_step=0.005, contact_model="hydroelastic_with_fallback",
         discrete_contact_approximation="sap"), builder)
-    wsg = make_parser(plant).AddModels(url="package://tg_drake_models/wsg_50/wsg_50.sdf")[0]
+    wsg = make_parser(plant).AddModels(url="package://tg_drake_models/wsg_50/wsg_50.urdf")[0]
     # The closing axis x_G along gravity.
     X_WG = RigidTransform(RollPitchYaw(0.0, np.pi / 2, 0.0), [0.0, 0.0, 0.5])
     plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("body", wsg), X_WG)

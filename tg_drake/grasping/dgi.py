@@ -16,7 +16,7 @@ For a gripper pose ``X_WG`` and an object point cloud ``p_W`` the feature is com
 Everything is vectorised over many hypotheses (M gripper poses) and points (N): no Python loop
 over points or poses.
 
-Gripper frame G is the WSG body frame of models/wsg_50/wsg_50.sdf: the fingers close along ±x_G,
+Gripper frame G is the WSG body frame of models/wsg_50/wsg_50.urdf: the fingers close along ±x_G,
 the approach direction is +y_G, z_G is across the finger pads. The pads' geometry below comes from
 tg_drake.robot, which the model file is written from (a test checks that they still agree).
 

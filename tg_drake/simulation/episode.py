@@ -5,7 +5,7 @@ simulates a Drake diagram, so it lives beside the station, not in the grasping c
 svm.py, hypotheses.py), which never imports it.
 
 The world: the table of models/table/table.sdf with its top at z_W = 0, one object resting on it,
-and the WSG 50 of models/wsg_50/wsg_50.sdf carried by six actuated joints — three prismatic and
+and the WSG 50 of models/wsg_50/wsg_50.urdf carried by six actuated joints — three prismatic and
 three revolute — on a frame F welded to the world at the grasp pose X_WG. The joints therefore
 measure the gripper's displacement from the grasp pose, expressed in the grasp frame, and are zero
 at the grasp; no parametrisation singularity occurs for any grasp orientation. Every joint is
@@ -203,7 +203,7 @@ class GraspWorld:
         models = files("tg_drake_models")
         (table,) = parser.AddModels(str(models / "table" / "table.sdf"))
         plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("table_top", table))
-        (wsg,) = parser.AddModels(str(models / "wsg_50" / "wsg_50.sdf"))
+        (wsg,) = parser.AddModels(str(models / "wsg_50" / "wsg_50.urdf"))
         object_models = parser.AddModels(object_sdf)
         bodies = [plant.get_body(i) for m in object_models for i in plant.GetBodyIndices(m)]
         if len(bodies) != 1:
