@@ -19,6 +19,7 @@ resolve against the scenario file's folder; `package://tg_drake_models/...` work
 
 import dataclasses
 import math
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -612,6 +613,7 @@ def validate(scenario: Scenario, *, where: str = "<scenario>",
     if isinstance(perception, DepthPerception) and perception.camera not in scenario.cameras:
         raise unknown_name("camera", perception.camera, list(scenario.cameras),
                            error=ScenarioError, file=where, field="pipeline.perception.camera")
+    _replace_retired_models(scenario, where)
     for name in scenario.model_drivers:
         if name not in ("iiwa", "wsg"):
             raise unknown_name("model driver", name, ["iiwa", "wsg"], error=ScenarioError,
@@ -625,6 +627,25 @@ def validate(scenario: Scenario, *, where: str = "<scenario>",
             scenario.receiver.validate("receiver")
     except ScenarioError as e:
         raise ScenarioError(e.message, file=where, field=e.field) from None
+
+
+# Shipped model files that were replaced, and their replacements (the same model): a scenario
+# written before (an exported case, a run's result.json `config`) names the old file.
+RETIRED_MODEL_FILES = {
+    "package://tg_drake_models/wsg_50/wsg_50.sdf": "package://tg_drake_models/wsg_50/wsg_50.urdf",
+}
+
+
+def _replace_retired_models(scenario: Scenario, where: str) -> None:
+    """Points the scenario's directives that add a retired model file (RETIRED_MODEL_FILES) at
+    its replacement, with a warning on stderr naming the field."""
+    for i, directive in enumerate(scenario.directives or ()):
+        model = directive.add_model
+        new = RETIRED_MODEL_FILES.get(model.file) if model is not None else None
+        if new:
+            print(f"warning: {where}: directives[{i}].add_model.file {model.file} is retired; "
+                  f"using {new}, the same model", file=sys.stderr)
+            model.file = new
 
 
 def _resolve_path(text: str, base_dir: Path | None) -> Path:

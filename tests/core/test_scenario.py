@@ -138,6 +138,23 @@ def test_the_resolved_scenario_round_trips_through_yaml(tmp_path):
     assert again.pipeline.planner.lift_height == 0.2
 
 
+def test_a_retired_model_file_in_the_directives_is_replaced(tmp_path, capsys):
+    # A scenario written before the WSG became a URDF (an exported case, a result's `config`).
+    from pydrake.common.yaml import yaml_dump_typed
+
+    from tg_drake.scenario import RETIRED_MODEL_FILES
+
+    old, new = next(iter(RETIRED_MODEL_FILES.items()))
+    text = yaml_dump_typed(Scenario(objects=[])).replace(new, old)
+    assert old in text
+    path = tmp_path / "old.yaml"
+    path.write_text(text)
+    s = load_scenario(path)
+    files = [d.add_model.file for d in s.directives if d.add_model]
+    assert new in files and old not in files
+    assert f"directives[2].add_model.file {old} is retired" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("text, field, message", [
     ("pipeline:\n  perception: ground_truth\n", "pipeline.perception",
      "expected one of !DepthPerception {...} or !GroundTruthPerception {...}, got 'ground_truth'"),
