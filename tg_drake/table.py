@@ -2,8 +2,8 @@
 
 One source of the table's facts. `table_sdf(size)` writes its model; `add_table` adds it to a plant
 with its top frame `table_top` welded at X_WT (the station and the planning plant both call it), and
-tools/make_robot_models.py writes models/table/table.sdf (the default size, used where there is no
-scenario: the grasp-collection episodes) from the same function.
+tools/make_robot_models.py writes models/table/table.sdf (the default size, for a scenario's own
+directives) from the same function.
 
 Frame `table_top`: origin at the centre of the top surface, z up, x away from the robot. The top is
 a box of `size` × TABLE_THICKNESS below the surface; the legs (visual only) stand TABLE_LEG_INSET

@@ -83,7 +83,8 @@ def _inertial_urdf(mass, com, inertia) -> str:
     ixx, iyy, izz = inertia
     return (f'    <inertial>\n      <origin xyz="{_f(com)}" rpy="0 0 0"/>\n'
             f'      <mass value="{mass}"/>\n'
-            f'      <inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/>\n'
+            f'      <inertia ixx="{ixx:.6g}" ixy="0" ixz="0" iyy="{iyy:.6g}" iyz="0" '
+            f'izz="{izz:.6g}"/>\n'
             f'    </inertial>\n')
 
 
@@ -92,6 +93,26 @@ def _geometry_urdf(shape) -> str:
     if kind == "sphere":
         return f'<sphere radius="{radius}"/>'
     return f'<cylinder radius="{radius}" length="{length}"/>'
+
+
+def _box_urdf(visual: str, collision: str, xyz, size, material: str, properties: str = "") -> str:
+    """A link's box as a visual and a collision element of the same origin and size."""
+    origin = f'      <origin xyz="{_f(xyz)}" rpy="0 0 0"/>\n'
+    box = f'      <geometry><box size="{_f(size)}"/></geometry>\n'
+    return (f'    <visual name="{visual}">\n' + origin + box
+            + f'      <material name="{material}"/>\n    </visual>\n'
+            f'    <collision name="{collision}">\n' + origin + box + properties
+            + "    </collision>")
+
+
+def _transmission_urdf(joint: str, actuator: str, interface: str) -> str:
+    """The transmission that makes Drake give `joint` an actuator named `actuator`."""
+    return (f'  <transmission name="{joint}_transmission">\n'
+            "    <type>transmission_interface/SimpleTransmission</type>\n"
+            f'    <joint name="{joint}"><hardwareInterface>{interface}'
+            "</hardwareInterface></joint>\n"
+            f'    <actuator name="{actuator}"><mechanicalReduction>1</mechanicalReduction>'
+            "</actuator>\n  </transmission>")
 
 
 def iiwa_urdf() -> str:
@@ -124,13 +145,7 @@ def iiwa_urdf() -> str:
                    f'    <limit lower="{-limit}" upper="{limit}" effort="{effort}" '
                    f'velocity="{velocity}"/>\n'
                    f'    <dynamics damping="0.0"/>\n  </joint>')
-        out.append(f'  <transmission name="{name}_transmission">\n'
-                   '    <type>transmission_interface/SimpleTransmission</type>\n'
-                   f'    <joint name="{name}"><hardwareInterface>PositionJointInterface'
-                   '</hardwareInterface></joint>\n'
-                   f'    <actuator name="{name}_actuator">'
-                   '<mechanicalReduction>1</mechanicalReduction>'
-                   '</actuator>\n  </transmission>')
+        out.append(_transmission_urdf(name, f"{name}_actuator", "PositionJointInterface"))
     out.append('  <joint name="iiwa_joint_ee" type="fixed">\n'
                '    <parent link="iiwa_link_7"/>\n    <child link="iiwa_link_ee"/>\n'
                f'    <origin xyz="0 0 {IIWA_FLANGE_Z}" rpy="0 0 0"/>\n  </joint>')
@@ -152,11 +167,6 @@ def _box_inertia(mass, size):
     return (mass * (y * y + z * z) / 12, mass * (x * x + z * z) / 12, mass * (x * x + y * y) / 12)
 
 
-def _inertia_6g(mass, size) -> tuple:
-    """A box's principal moments [kg·m²], written to 6 significant digits."""
-    return tuple(float(f"{v:.6g}") for v in _box_inertia(mass, size))
-
-
 def _compliant_urdf(h) -> str:
     """A compliant-hydroelastic collision's properties (Drake's URDF form: values as
     attributes)."""
@@ -174,7 +184,6 @@ def wsg_urdf() -> str:
     """The WSG 50 in URDF: Drake parses a URDF file in well under a millisecond, the same model
     as an SDFormat file in about 26 ms (libsdformat's file loading), and the planner builds an
     arm plant with the gripper many times per plan."""
-    body_xyz = _f(WSG_BODY_CENTRE_G)
     out = ['<?xml version="1.0"?>',
            "<!-- Schunk WSG 50 parallel gripper, written by tools/make_robot_models.py from",
            "     the figures of tg_drake/robot.py (the WSG 50 data sheet). Frame of `body` (G):",
@@ -189,12 +198,9 @@ def wsg_urdf() -> str:
            '  <material name="wsg_pad"><color rgba="0.2 0.2 0.2 1"/></material>',
            f'  <link name="{WSG_BODY}">',
            _inertial_urdf(WSG_BODY_MASS, WSG_BODY_CENTRE_G,
-                          _inertia_6g(WSG_BODY_MASS, WSG_BODY_SIZE)).rstrip("\n"),
-           f'    <visual name="body_visual">\n      <origin xyz="{body_xyz}" rpy="0 0 0"/>\n'
-           f'      <geometry><box size="{_f(WSG_BODY_SIZE)}"/></geometry>\n'
-           '      <material name="wsg_body"/>\n    </visual>',
-           f'    <collision name="body_collision">\n      <origin xyz="{body_xyz}" rpy="0 0 0"/>\n'
-           f'      <geometry><box size="{_f(WSG_BODY_SIZE)}"/></geometry>\n    </collision>',
+                          _box_inertia(WSG_BODY_MASS, WSG_BODY_SIZE)).rstrip("\n"),
+           _box_urdf("body_visual", "body_collision", WSG_BODY_CENTRE_G, WSG_BODY_SIZE,
+                     "wsg_body"),
            "  </link>"]
     for finger, joint, sign, lower, upper in zip(WSG_FINGERS, WSG_FINGER_JOINTS, (-1, 1),
                                                  (-WSG_STROKE, 0.0), (0.0, WSG_STROKE),
@@ -204,15 +210,9 @@ def wsg_urdf() -> str:
         pad_xyz = (sign * WSG_PAD_SIZE[0] / 2, WSG_PAD_CENTRE_Y, 0.0)
         out += [f'  <link name="{finger}">',
                 _inertial_urdf(WSG_FINGER_MASS, pad_xyz,
-                               _inertia_6g(WSG_FINGER_MASS, WSG_PAD_SIZE)).rstrip("\n"),
-                f'    <visual name="{finger}_visual">\n'
-                f'      <origin xyz="{_f(pad_xyz)}" rpy="0 0 0"/>\n'
-                f'      <geometry><box size="{_f(WSG_PAD_SIZE)}"/></geometry>\n'
-                '      <material name="wsg_pad"/>\n    </visual>',
-                f'    <collision name="{finger}_pad">\n'
-                f'      <origin xyz="{_f(pad_xyz)}" rpy="0 0 0"/>\n'
-                f'      <geometry><box size="{_f(WSG_PAD_SIZE)}"/></geometry>\n'
-                + _compliant_urdf(PAD_HYDRO) + "    </collision>",
+                               _box_inertia(WSG_FINGER_MASS, WSG_PAD_SIZE)).rstrip("\n"),
+                _box_urdf(f"{finger}_visual", f"{finger}_pad", pad_xyz, WSG_PAD_SIZE, "wsg_pad",
+                          _compliant_urdf(PAD_HYDRO)),
                 "  </link>",
                 f'  <joint name="{joint}" type="prismatic">\n'
                 f'    <parent link="{WSG_BODY}"/>\n    <child link="{finger}"/>\n'
@@ -220,12 +220,7 @@ def wsg_urdf() -> str:
                 f'    <limit lower="{lower}" upper="{upper}" effort="{WSG_FORCE_LIMIT}" '
                 f'velocity="{WSG_FINGER_VELOCITY}"/>\n'
                 '    <dynamics damping="0"/>\n  </joint>',
-                f'  <transmission name="{joint}_transmission">\n'
-                '    <type>transmission_interface/SimpleTransmission</type>\n'
-                f'    <joint name="{joint}"><hardwareInterface>EffortJointInterface'
-                '</hardwareInterface></joint>\n'
-                f'    <actuator name="{joint}"><mechanicalReduction>1</mechanicalReduction>'
-                '</actuator>\n  </transmission>']
+                _transmission_urdf(joint, joint, "EffortJointInterface")]
     out.append("</robot>")
     return "\n".join(out) + "\n"
 

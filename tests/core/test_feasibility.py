@@ -12,15 +12,18 @@ from tg_drake.grasping.feasibility import (
     FeasibilityConfig,
     box_signed_distance,
     collision,
+    deepest_cuts,
     grasp_feasibility,
+    gripper_boxes,
     hold,
     hull_volume,
     load_hold_model,
     mean_density,
+    others_hit,
     point_normals,
     why_no_pose,
 )
-from tg_drake.robot import WSG_MAX_OPENING, WSG_PAD_SIZE
+from tg_drake.robot import WSG_BODY_CENTRE_G, WSG_BODY_SIZE, WSG_MAX_OPENING, WSG_PAD_SIZE
 from tg_drake.types import GraspCandidates
 
 CONFIG = FeasibilityConfig()
@@ -277,14 +280,6 @@ def test_deepest_cuts_and_others_hit_measure_how_deep_points_enter_the_housing()
     """A slab of points 4 mm inside the housing's back face (y_G = −0.0213 − 0.03625 m), at the
     identity pose and at one 1 m away: the deepest cut is 4 mm there, 0 away; `others_hit` names
     the housing for the first and nothing for the second."""
-    from tg_drake.grasping.feasibility import (
-        FeasibilityConfig,
-        deepest_cuts,
-        gripper_boxes,
-        others_hit,
-    )
-    from tg_drake.robot import WSG_BODY_CENTRE_G, WSG_BODY_SIZE
-
     back = WSG_BODY_CENTRE_G[1] - WSG_BODY_SIZE[1] / 2
     g = np.linspace(-0.02, 0.02, 9)
     p = np.stack(np.meshgrid(g, [back + 0.004], g, indexing="ij"), axis=-1).reshape(-1, 3)

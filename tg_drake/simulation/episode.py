@@ -4,13 +4,13 @@ This module labels training data for the DGI classifier (tools/collect_grasps.py
 simulates a Drake diagram, so it lives beside the station, not in the grasping core (dgi.py,
 svm.py, hypotheses.py), which never imports it.
 
-The world: the table of models/table/table.sdf with its top at z_W = 0, one object resting on it,
-and the WSG 50 of models/wsg_50/wsg_50.urdf carried by six actuated joints — three prismatic and
-three revolute — on a frame F welded to the world at the grasp pose X_WG. The joints therefore
-measure the gripper's displacement from the grasp pose, expressed in the grasp frame, and are zero
-at the grasp; no parametrisation singularity occurs for any grasp orientation. Every joint is
-PD-controlled through its JointActuator gains with the desired state on the plant's
-`desired_state` input port (implicit in SAP); gravity is off for the gripper's
+The world: the table (tg_drake.table, its default size) with its top at z_W = 0, one object
+resting on it, and the WSG 50 of models/wsg_50/wsg_50.urdf carried by six actuated joints — three
+prismatic and three revolute — on a frame F welded to the world at the grasp pose X_WG. The
+joints therefore measure the gripper's displacement from the grasp pose, expressed in the grasp
+frame, and are zero at the grasp; no parametrisation singularity occurs for any grasp
+orientation. Every joint is PD-controlled through its JointActuator gains with the desired state
+on the plant's `desired_state` input port (implicit in SAP); gravity is off for the gripper's
 bodies, which stand in for an arm that compensates it.
 
 An episode (all times in seconds, `EpisodeConfig`):
@@ -57,6 +57,7 @@ from tg_drake.grasping.dgi import MAX_OPENING
 from tg_drake.outcome import HandGeometries, hand_contact, touches_table
 from tg_drake.robot import WSG_BODY, WSG_FINGER_JOINTS
 from tg_drake.robot_plants import couple_fingers
+from tg_drake.table import TABLE_SIZE, add_table
 
 TABLE_TOP_Z = 0.0  # the table's top surface in the world [m] (table_top frame welded at W).
 FINGER_JOINTS = WSG_FINGER_JOINTS
@@ -200,10 +201,9 @@ class GraspWorld:
                                  discrete_contact_approximation="sap"),
             builder)
         parser = Parser(plant)
-        models = files("tg_drake_models")
-        (table,) = parser.AddModels(str(models / "table" / "table.sdf"))
-        plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("table_top", table))
-        (wsg,) = parser.AddModels(str(models / "wsg_50" / "wsg_50.urdf"))
+        # (from its text: a table file would take libsdformat ~25 ms to load at every world)
+        table = add_table(plant, TABLE_SIZE, RigidTransform([0.0, 0.0, TABLE_TOP_Z]))
+        (wsg,) = parser.AddModels(str(files("tg_drake_models") / "wsg_50" / "wsg_50.urdf"))
         object_models = parser.AddModels(object_sdf)
         bodies = [plant.get_body(i) for m in object_models for i in plant.GetBodyIndices(m)]
         if len(bodies) != 1:
