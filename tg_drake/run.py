@@ -72,6 +72,7 @@ def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
 
     from tg_drake.diagram import add_pipeline
     from tg_drake.render import PositionRecorder, key_times, render_key_frames
+    from tg_drake.simulation.sleep import ContentsSleep, advance
     from tg_drake.report import Pictures, Stages, evaluate_stages, final_stages, result_of
     from tg_drake.systems.supervisor import Outcome, Reason, Status, outcome_of_error
 
@@ -114,6 +115,8 @@ def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
                 if outcome_now(root).final else EventStatus.DidNothing())
 
     simulator.set_monitor(monitor)
+    # Resting contents leave the physics while nothing near them moves (tg_drake.simulation.sleep).
+    sleeper = ContentsSleep.for_station(pipeline.station, scenario.contents)
 
     if visualizer is not None:
         visualizer.StartRecording()
@@ -124,7 +127,7 @@ def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
         simulator.Initialize()
         stages = evaluate_stages(pipeline, context, timings, rgb=images)
         t_sim = time.perf_counter()
-        simulator.AdvanceTo(scenario.simulation_duration)
+        advance(simulator, scenario.simulation_duration, sleeper)
     except (TgDrakeError, RuntimeError) as e:  # a stage failed, or the simulation did
         error = e
     finally:

@@ -1,19 +1,22 @@
 """Contents as spheres in physics: every sphere accounted for, none through a wall.
 
-A full cup standing on the table keeps its spheres; the same cup turned upside down above the
+A full cup standing on the table keeps its spheres (asleep once they rest, awake again when the
+cup is pushed); the same cup turned upside down above the
 table by a test rig (the cup welded to a link on a PD-driven revolute joint) pours them all onto
 the table; the dispenser drops its spheres into an empty bowl standing below it, and keeps them
-while its gate is closed. Counts are those of `count_contents`, the task check's.
+while its gate is closed (opened while they sleep on it, it wakes them). Counts are those of `count_contents`, the task check's.
 """
 
 import numpy as np
 import pytest
+from pydrake.multibody.math import SpatialVelocity
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.analysis import Simulator
 
 from tg_drake.objects import WATER_DENSITY, get_object
 from tg_drake.scenario import load_scenario
 from tg_drake.simulation.pour import tilt_rig
+from tg_drake.simulation.sleep import ContentsSleep, advance
 from tg_drake.station import CONTENTS_WALL, make_station
 from tg_drake.tasks.contents import ContentsConfig, count_contents
 
@@ -59,6 +62,46 @@ def test_a_full_cup_standing_for_1_s_keeps_every_sphere():
     simulator.AdvanceTo(1.0)
     (after,) = _station_counts(diagram, station, context, {CUP: CUP})
     assert after == {CUP: len(model.bodies), "table": 0, "floor": 0, "elsewhere": 0}
+
+
+def _sphere_positions(station, context):
+    plant = station.plant
+    plant_context = plant.GetMyContextFromRoot(context)
+    return np.array([plant.EvalBodyPoseInWorld(plant_context, plant.get_body(BodyIndex(b)))
+                     .translation() for m in station.contents for b in m.bodies])
+
+
+def test_resting_spheres_sleep_where_they_lie_and_wake_when_their_cup_is_pushed():
+    scenario = load_scenario(scenario_text=FULL_CUP)
+    diagram, station = make_station(scenario)
+    (model,) = station.contents
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    _hold_robot(diagram, station, context)
+    sleeper = ContentsSleep.for_station(station, scenario.contents)
+    advance(simulator, 1.5, sleeper)  # settled within 0.75 s, then still for sleep_after
+    assert sleeper.asleep and [e for _, e in sleeper.events] == ["sleep"]
+    p_asleep = _sphere_positions(station, context)
+    advance(simulator, 2.0, sleeper)
+    assert np.array_equal(_sphere_positions(station, context), p_asleep)  # locked where they lay
+    # Pushed sideways at 0.5 m/s: the next step wakes them, and they stay in the cup.
+    plant = station.plant
+    plant.SetFreeBodySpatialVelocity(plant.GetMyMutableContextFromRoot(context),
+                                     station.object_body(CUP),
+                                     SpatialVelocity(w=[0.0, 0.0, 0.0], v=[0.5, 0.0, 0.0]))
+    advance(simulator, 2.005, sleeper)
+    assert not sleeper.asleep and sleeper.events[-1] == (2.005, "wake")
+    advance(simulator, 3.0, sleeper)
+    (counts,) = _station_counts(diagram, station, context, {CUP: CUP})
+    assert counts == {CUP: len(model.bodies), "table": 0, "floor": 0, "elsewhere": 0}
+    assert not np.array_equal(_sphere_positions(station, context), p_asleep)
+
+
+def test_without_sleep_no_sleeper_is_made():
+    scenario = load_scenario(scenario_text=FULL_CUP + "contents: {model: spheres, sleep: false}\n"
+                             .replace("contents: {model: spheres}\n", ""))
+    _, station = make_station(scenario)
+    assert station.contents and ContentsSleep.for_station(station, scenario.contents) is None
 
 
 def test_the_spheres_touch_the_simplified_wall_and_everything_else_the_original_mesh():
@@ -137,6 +180,24 @@ def test_the_dispenser_drops_its_spheres_into_the_bowl_below_only_when_open(open
         assert counts == {BOWL: 12, "table": 0, "floor": 0, "elsewhere": 0}
     else:
         assert counts == {BOWL: 0, "table": 0, "floor": 0, "elsewhere": 12}
+
+
+def test_a_gate_opened_under_sleeping_spheres_wakes_them_and_they_fall_into_the_bowl():
+    scenario = _dispenser_scenario()
+    diagram, station = make_station(scenario)
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    _hold_robot(diagram, station, context)
+    gate = diagram.GetInputPort("dispenser.open")
+    gate.FixValue(context, [0.0])
+    sleeper = ContentsSleep.for_station(station, scenario.contents)
+    advance(simulator, 1.5, sleeper)
+    assert sleeper.asleep
+    gate.FixValue(context, [1.0])
+    advance(simulator, 3.0, sleeper)
+    assert "wake" in [e for _, e in sleeper.events]
+    (counts,) = _station_counts(diagram, station, context, {BOWL: BOWL})
+    assert counts == {BOWL: 12, "table": 0, "floor": 0, "elsewhere": 0}
 
 
 def test_the_camera_sees_a_full_cup_of_spheres_as_a_full_cup_of_water():

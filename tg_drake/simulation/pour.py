@@ -31,6 +31,7 @@ from tg_drake.objects import WATER_DENSITY, get_object, mesh
 from tg_drake.robot import WSG_MAX_OPENING
 from tg_drake.scenario import ObjectPlacement, Scenario, default_plant_config
 from tg_drake.simulation.scripted import drive_station, side_grasp_configurations
+from tg_drake.simulation.sleep import ContentsSleep, advance
 from tg_drake.station import add_contents_wall, add_spheres, spheres_touch_walls
 from tg_drake.table import TABLE_SIZE, X_WT_DEFAULT, add_table
 from tg_drake.tasks.contents import ContentsConfig, ContentsModel, container_sites, count_contents
@@ -121,7 +122,7 @@ def scripted_pour(scenario: Scenario, *, object_name: str, p_W_grasp, tilt: floa
     plant = station.plant
     body = station.object_body(object_name)
     z0 = body.EvalPoseInWorld(plant_context).translation()[2]
-    simulator.AdvanceTo(times[-1])
+    advance(simulator, times[-1], ContentsSleep.for_station(station, scenario.contents))
     wall = time.perf_counter() - t0
     X_WO = body.EvalPoseInWorld(plant_context)
     poses = plant.get_body_poses_output_port().Eval(plant_context)

@@ -55,6 +55,17 @@ DISPENSER_COUNT = MAX_SPHERES  # [1] spheres in a dispenser by default
 DISPENSER_WIDTH = 0.045  # [m] inner side of the dispenser's square hopper by default
 DISPENSER_WALL = 0.004  # [m] thickness of the hopper's walls and of its gate
 
+# Sleep (tg_drake.simulation.sleep). Measured on a full library cup standing in the station,
+# robot idle: its 10 spheres, dropped from their lattice sites, settle within 0.75 s (every
+# sphere's speed bound under 7e-4 m/s, 3e-4 at 1 s, 4e-5 at 3 s: SAP's regularised friction lets
+# resting contacts creep); a sphere rolling or sliding is far faster.
+SLEEP_SPEED = 0.002  # [m/s] still: slower than this (centre's speed + spin × radius)
+SLEEP_AFTER = 0.2  # [s] still this long (40 steps of 5 ms) before they sleep
+SLEEP_PERIOD = 0.05  # [s] simulated time between checks (10 steps)
+WAKE_MARGIN = 0.03  # [m] a body moving at up to 0.6 m/s crosses it between two checks
+WAKE_SHIFT = 0.001  # [m] a near body (the container they lie in) moved this far wakes them;
+# they then overlap its wall by at most that much
+
 LATTICE_GAP = 0.05  # [1] lattice spacing = 2·radius·(1 + gap): spheres start apart
 CLEARANCE = 1.1  # [1] a start site is at least this many radii from the container's mesh
 ON_TABLE = 3.0  # [radii] a sphere's centre this near the table top lies on the table or on spheres
@@ -79,6 +90,14 @@ class ContentsConfig:
     friction: float = SPHERE_FRICTION  # [1] Coulomb friction (static = dynamic)
     mutual: bool = True  # the spheres touch each other (False: each touches only the rest of
     # the world, a cheaper fluid that keeps no volume)
+    # Resting spheres asleep (tg_drake.simulation.sleep): out of the physics while they and
+    # everything near them lie still, until something near them moves.
+    sleep: bool = True
+    sleep_speed: float = SLEEP_SPEED  # [m/s] still: slower than this (centre + spin × radius)
+    sleep_after: float = SLEEP_AFTER  # [s] still this long before they sleep
+    sleep_period: float = SLEEP_PERIOD  # [s] simulated time between checks
+    wake_margin: float = WAKE_MARGIN  # [m] a body this near a sphere is near them
+    wake_shift: float = WAKE_SHIFT  # [m] a near body moved this far wakes them
 
     def validate(self, where: str = "contents") -> None:
         if self.model not in CONTENTS_MODELS:
@@ -87,6 +106,9 @@ class ContentsConfig:
         _check_count(self.count, f"{where}.count")
         _check_count(self.max_count, f"{where}.max_count", positive=True)
         for name, unit in (("radius", "m"), ("modulus", "Pa"), ("resolution_hint", "m")):
+            _check_positive(getattr(self, name), f"{where}.{name}", unit)
+        for name, unit in (("sleep_speed", "m/s"), ("sleep_after", "s"), ("sleep_period", "s"),
+                           ("wake_margin", "m"), ("wake_shift", "m")):
             _check_positive(getattr(self, name), f"{where}.{name}", unit)
         for name, unit in (("dissipation", "s/m"), ("friction", "1")):
             _check_positive(getattr(self, name), f"{where}.{name}", unit, allow_zero=True)

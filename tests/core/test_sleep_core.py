@@ -1,0 +1,36 @@
+"""The contents' sleep rules on arrays (tg_drake.simulation.sleep): speed bounds, which bodies
+are near the spheres, how far a body moved."""
+
+import numpy as np
+import pytest
+
+from tg_drake.simulation.sleep import near_spheres, shifted, speeds
+
+
+def test_a_body_s_speed_bound_adds_its_spin_times_its_reach():
+    v = np.array([[0.003, 0.004, 0.0], [0.0, 0.0, 0.0]])  # [m/s]
+    w = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 2.0]])  # [rad/s]
+    assert speeds(v, w, np.array([0.5, 0.1])) == pytest.approx([0.005, 0.2])
+
+
+def test_a_body_is_near_when_its_bounding_sphere_comes_within_the_margin_of_a_sphere():
+    p_spheres = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]])
+    centres = np.array([[0.1, 0.15, 0.0],    # 0.15 from the nearest sphere
+                        [-0.3, 0.0, 0.0],    # 0.3
+                        [0.5, 0.0, 0.0]])    # 0.4
+    radii = np.array([0.1, 0.2, 0.1])
+    # reach: radius 0.1 + sphere 0.01 + margin 0.03 = 0.14 < 0.15; 0.2 + 0.04 = 0.24 < 0.3
+    assert list(near_spheres(p_spheres, 0.01, centres, radii, 0.03)) == [False, False, False]
+    assert list(near_spheres(p_spheres, 0.01, centres, radii, 0.05)) == [True, False, False]
+    assert list(near_spheres(p_spheres, 0.01, centres, radii, 0.1)) == [True, True, False]
+    assert near_spheres(np.zeros((0, 3)), 0.01, centres, radii, 0.1).tolist() == [False] * 3
+
+
+def test_a_body_s_shift_is_its_displacement_plus_its_turn_times_its_reach():
+    X0 = np.tile(np.eye(4), (2, 1, 1))
+    X1 = X0.copy()
+    X1[0, :3, 3] = [0.003, 0.0, 0.004]  # moved 5 mm
+    c, s = np.cos(0.01), np.sin(0.01)
+    X1[1, :3, :3] = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]  # turned 0.01 rad
+    assert shifted(X0, X1, np.array([1.0, 0.2])) == pytest.approx([0.005, 0.002], abs=1e-9)
+    assert shifted(X0, X0, np.array([1.0, 0.2])) == pytest.approx([0.0, 0.0], abs=1e-6)

@@ -1,0 +1,258 @@
+"""Resting contents asleep: spheres that lie still, with nothing moving near them, leave the
+physics until something near them moves again.
+
+A container's spheres cost most while they lie still: in the container before it is grasped, in
+the target bowl after a pour, on the table after a spill (`tg_drake.tasks.contents`: each resting
+sphere is a contact surface clipped against its container's mesh at every step). Physics engines
+let such bodies sleep; Drake does not, so the simulation loop does it between steps
+(`advance`):
+
+- **Asleep**: every sphere has been still (`ContentsConfig.sleep_speed` [m/s]: its centre's
+  speed plus its spin times its radius) for `sleep_after` [s], and so has every other body near
+  them (a body is near when its bounding sphere, from its collision geometries, comes within
+  `wake_margin` [m] of a sphere). Then every sphere's joint is locked (SAP drops its degrees of
+  freedom) and its contacts are filtered (a transient collision filter in the scene graph's
+  context: no contact surface is computed for it). They stay exactly where they lay.
+- **Awake** again, at the first check after: a body near them moves faster than
+  `sleep_speed`, or a body that was near when they fell asleep (the container they lie in, the
+  bowl) has moved or turned by `wake_shift` [m] at its bounding sphere. The filter is removed and
+  the joints unlocked; they go on from rest where they lay.
+
+All spheres sleep and wake together: one sphere resting on another never loses its support.
+The full check runs every `sleep_period` [s] of simulated time; while they sleep, the bodies
+that were near them are watched after every plant step, so a support that starts to move (a
+dispenser's gate sliding open, a container taken by the hand) wakes them one step later. Checks
+run at fixed simulated times: a run is deterministic. While asleep the spheres' weight does not
+press on what they lie in; nothing near them moves then, so nothing can tell. `contents:
+{sleep: false}` turns it off.
+
+    sleeper = ContentsSleep.for_station(station, root_context, scenario.contents)
+    advance(simulator, t_end, sleeper)   # simulator.AdvanceTo with the checks in between
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, Role
+from pydrake.multibody.tree import BodyIndex
+from pydrake.systems.analysis import SimulatorStatus
+
+# ---------------------------------------------------------------------------------------------
+# The core: decisions on arrays.
+
+
+def speeds(v_W: np.ndarray, w_W: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """[m/s] a bound on how fast any point of each body moves: its reference point's speed
+    |v_W| (n, 3) plus its spin |w_W| (n, 3) [rad/s] times `reach` (n,) [m], the farthest its
+    geometry lies from that point."""
+    return (np.linalg.norm(np.asarray(v_W, float), axis=1)
+            + np.linalg.norm(np.asarray(w_W, float), axis=1) * np.asarray(reach, float))
+
+
+def near_spheres(p_spheres: np.ndarray, radius: float, centres: np.ndarray, radii: np.ndarray,
+                 margin: float) -> np.ndarray:
+    """Which bodies (bounding spheres `centres` (m, 3), `radii` (m,) [m]) come within `margin`
+    [m] of some sphere of `radius` [m] centred at `p_spheres` (n, 3): a bool (m,) array."""
+    p = np.asarray(p_spheres, float).reshape(-1, 3)
+    c = np.asarray(centres, float).reshape(-1, 3)
+    if len(p) == 0 or len(c) == 0:
+        return np.zeros(len(c), bool)
+    d = np.linalg.norm(c[:, None, :] - p[None, :, :], axis=2).min(axis=1)
+    return d < np.asarray(radii, float) + radius + margin
+
+
+def shifted(X_then: np.ndarray, X_now: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """[m] how far each body's geometry moved between two poses (k, 4, 4) at most: its reference
+    point's displacement plus the turn's angle times `reach` (k,) [m]."""
+    X0, X1 = np.asarray(X_then, float), np.asarray(X_now, float)
+    move = np.linalg.norm(X1[:, :3, 3] - X0[:, :3, 3], axis=1)
+    R = np.einsum("kji,kjl->kil", X0[:, :3, :3], X1[:, :3, :3])  # R0ᵀ R1
+    cos = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    return move + np.arccos(cos) * np.asarray(reach, float)
+
+
+# ---------------------------------------------------------------------------------------------
+# The station's bodies and the loop.
+
+
+@dataclass
+class _Bounds:
+    """A body's bounding sphere: centre in the body frame, radius [m]."""
+
+    body: object
+    p_BC: np.ndarray
+    radius: float
+
+
+def bounding_sphere(plant, inspector, body) -> _Bounds | None:
+    """The sphere about the body's collision geometries' oriented boxes (None: no collision
+    geometry, or none with a box — it touches nothing the spheres do)."""
+    corners = []
+    for g in plant.GetCollisionGeometriesForBody(body):
+        obb = inspector.GetObbInGeometryFrame(g)
+        if obb is None:
+            continue
+        X_BG = inspector.GetPoseInFrame(g).GetAsMatrix4()
+        X_GO = obb.pose().GetAsMatrix4()
+        h = obb.half_width()
+        signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+        p_O = signs * h
+        corners.append((X_BG @ X_GO @ np.c_[p_O, np.ones(8)].T).T[:, :3])
+    if not corners:
+        return None
+    pts = np.vstack(corners)
+    centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    return _Bounds(body, centre, float(np.linalg.norm(pts - centre, axis=1).max()))
+
+
+@dataclass
+class ContentsSleep:
+    """The spheres' sleep and wake (module doc) for one simulator's plant; `update` at each
+    check. `events` lists (simulated time [s], "sleep" | "wake") for the record."""
+
+    plant: object
+    scene_graph: object
+    spheres: list  # the spheres' bodies
+    radius: float  # [m] the largest sphere's
+    others: list[_Bounds]  # every other body that can move and touch
+    config: object  # ContentsConfig (its sleep_* fields)
+    still_since: float | None = None
+    asleep: bool = False
+    filter_id: object = None
+    near_then: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
+    X_then: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 4)))
+    watched: list = field(default_factory=list)  # (body, reach [m], X_WB at sleep) of near ones
+    events: list = field(default_factory=list)
+
+    @classmethod
+    def for_station(cls, station, config) -> "ContentsSleep | None":
+        """None when the station has no spheres or `config.sleep` is off."""
+        if not getattr(config, "sleep", False) or not station.contents:
+            return None
+        plant = station.plant
+        inspector = station.scene_graph.model_inspector()
+        spheres = [plant.get_body(BodyIndex(b)) for m in station.contents for b in m.bodies]
+        if not spheres:
+            return None
+        ids = {int(b.index()) for b in spheres}
+        static = {int(b.index()) for b in plant.GetBodiesWeldedTo(plant.world_body())}
+        others = []
+        for i in range(plant.num_bodies()):
+            body = plant.get_body(BodyIndex(i))
+            if i in ids or i in static:
+                continue
+            bounds = bounding_sphere(plant, inspector, body)
+            if bounds is not None:
+                others.append(bounds)
+        radius = max(m.radius for m in station.contents)
+        return cls(plant, station.scene_graph, spheres, radius, others, config)
+
+    def _state(self, plant_context):
+        poses = self.plant.get_body_poses_output_port().Eval(plant_context)
+        vels = self.plant.get_body_spatial_velocities_output_port().Eval(plant_context)
+
+        def arrays(bodies, reach_of):
+            X = np.array([poses[b.index()].GetAsMatrix4() for b in bodies]).reshape(-1, 4, 4)
+            V = [vels[b.index()] for b in bodies]
+            v = np.array([s.translational() for s in V]).reshape(-1, 3)
+            w = np.array([s.rotational() for s in V]).reshape(-1, 3)
+            return X, speeds(v, w, reach_of)
+
+        X_s, v_s = arrays(self.spheres, np.full(len(self.spheres), self.radius))
+        bodies = [o.body for o in self.others]
+        p_BC = np.array([o.p_BC for o in self.others]).reshape(-1, 3)
+        radii = np.array([o.radius for o in self.others])
+        X_o, v_o = arrays(bodies, self._reach())
+        centres = np.einsum("kij,kj->ki", X_o[:, :3, :3], p_BC) + X_o[:, :3, 3]
+        return X_s[:, :3, 3], v_s, X_o, v_o, centres, radii
+
+    def _reach(self) -> np.ndarray:
+        """[m] the farthest each other body's geometry lies from its origin."""
+        return np.array([np.linalg.norm(o.p_BC) + o.radius for o in self.others])
+
+    def update(self, root_context) -> None:
+        """One check at the context's time (module doc)."""
+        c = self.config
+        t = root_context.get_time()
+        plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
+        p_s, v_s, X_o, v_o, centres, radii = self._state(plant_context)
+        near = near_spheres(p_s, self.radius, centres, radii, c.wake_margin)
+        reach = self._reach()
+        if self.asleep:
+            moved = shifted(self.X_then[self.near_then], X_o[self.near_then],
+                            reach[self.near_then]) > c.wake_shift
+            if np.any(v_o[near] > c.sleep_speed) or np.any(moved):
+                self._wake(root_context, t)
+            return
+        if np.all(v_s < c.sleep_speed) and np.all(v_o[near] < c.sleep_speed):
+            if self.still_since is None:
+                self.still_since = t
+            elif t - self.still_since >= c.sleep_after - 1e-9:
+                self._sleep(root_context, t, near, X_o)
+        else:
+            self.still_since = None
+
+    def watch(self, root_context) -> None:
+        """The check after every step while they sleep: a body that was near them when they
+        fell asleep moves faster than `sleep_speed` or has moved by `wake_shift` — wake."""
+        c = self.config
+        plant_context = self.plant.GetMyContextFromRoot(root_context)
+        for body, reach, X_then in self.watched:
+            V = self.plant.EvalBodySpatialVelocityInWorld(plant_context, body)
+            X = self.plant.EvalBodyPoseInWorld(plant_context, body).GetAsMatrix4()
+            if (speeds(V.translational()[None], V.rotational()[None], [reach])[0]
+                    > c.sleep_speed or shifted(X_then[None], X[None], [reach])[0] > c.wake_shift):
+                self._wake(root_context, root_context.get_time())
+                return
+
+    def _sleep(self, root_context, t, near, X_o) -> None:
+        plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
+        for b in self.spheres:
+            b.Lock(plant_context)
+        sg_context = self.scene_graph.GetMyMutableContextFromRoot(root_context)
+        inspector = self.scene_graph.model_inspector()
+        mine = [g for b in self.spheres for g in self.plant.GetCollisionGeometriesForBody(b)]
+        everything = list(inspector.GetAllGeometryIds(Role.kProximity))
+        self.filter_id = self.scene_graph.collision_filter_manager(sg_context).ApplyTransient(
+            CollisionFilterDeclaration().ExcludeBetween(GeometrySet(mine),
+                                                        GeometrySet(everything)))
+        self.asleep, self.near_then, self.X_then = True, near.copy(), X_o.copy()
+        reach = self._reach()
+        self.watched = [(self.others[i].body, float(reach[i]), X_o[i])
+                        for i in np.flatnonzero(near)]
+        self.events.append((round(float(t), 6), "sleep"))
+
+    def _wake(self, root_context, t) -> None:
+        sg_context = self.scene_graph.GetMyMutableContextFromRoot(root_context)
+        self.scene_graph.collision_filter_manager(sg_context).RemoveDeclaration(self.filter_id)
+        plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
+        for b in self.spheres:
+            b.Unlock(plant_context)
+        self.asleep, self.filter_id, self.still_since = False, None, None
+        self.events.append((round(float(t), 6), "wake"))
+
+
+def advance(simulator, t_end: float, sleeper: ContentsSleep | None) -> None:
+    """`simulator.AdvanceTo(t_end)`; with a `sleeper`, one plant step at a time: every
+    `sleep_period` a full check (`ContentsSleep.update`), and while the spheres sleep, after
+    every step a watch on the bodies that were near them (`ContentsSleep.watch`: a support that
+    starts to move wakes them one step later). Stops early, as AdvanceTo does, when the
+    simulator's monitor says so."""
+    if sleeper is None:
+        simulator.AdvanceTo(t_end)
+        return
+    context = simulator.get_context()
+    h = sleeper.plant.time_step()
+    every = max(1, int(round(sleeper.config.sleep_period / h)))
+    k = int(np.floor(context.get_time() / h + 1e-6))
+    while context.get_time() < t_end - 1e-12:
+        k += 1
+        status = simulator.AdvanceTo(min(t_end, k * h))
+        if status.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition:
+            return
+        if k % every == 0:
+            sleeper.update(simulator.get_mutable_context())
+        elif sleeper.asleep:
+            sleeper.watch(simulator.get_mutable_context())
