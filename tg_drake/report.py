@@ -385,7 +385,10 @@ def summary(result: dict) -> str:
                      f"it and opened again) before the retreat")
     t = result["timings"]
     lines.append("timings    " + ", ".join(f"{k} {v:.2f}s" for k, v in t.items()
-                                          if k != "simulated_time"))
+                                          if k not in ("simulated_time", "contents_asleep")))
+    if t.get("contents_asleep"):
+        lines.append(f"contents   asleep {t['contents_asleep']:.2f} of {t['simulated_time']:.2f} "
+                     "simulated s (resting, nothing moving near them)")
     for w in result.get("warnings", []):
         lines.append(f"warning    {w}")
     return "\n".join(lines)

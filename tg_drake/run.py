@@ -72,8 +72,8 @@ def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
 
     from tg_drake.diagram import add_pipeline
     from tg_drake.render import PositionRecorder, key_times, render_key_frames
-    from tg_drake.simulation.sleep import ContentsSleep, advance
     from tg_drake.report import Pictures, Stages, evaluate_stages, final_stages, result_of
+    from tg_drake.simulation.sleep import ContentsSleep, advance
     from tg_drake.systems.supervisor import Outcome, Reason, Status, outcome_of_error
 
     timings: dict[str, float] = {}
@@ -133,6 +133,8 @@ def run(scenario, *, scenario_path: str = "", meshcat=None, images: bool = False
     finally:
         timings["simulation"] = time.perf_counter() - t_sim
         timings["simulated_time"] = context.get_time()
+        if sleeper is not None:
+            timings["contents_asleep"] = round(sleeper.asleep_time(context.get_time()), 3)
         if visualizer is not None:
             visualizer.StopRecording()
             visualizer.PublishRecording()

@@ -4,7 +4,7 @@ are near the spheres, how far a body moved."""
 import numpy as np
 import pytest
 
-from tg_drake.simulation.sleep import near_spheres, shifted, speeds
+from tg_drake.simulation.sleep import ContentsSleep, near_spheres, shifted, speeds
 
 
 def test_a_body_s_speed_bound_adds_its_spin_times_its_reach():
@@ -34,3 +34,10 @@ def test_a_body_s_shift_is_its_displacement_plus_its_turn_times_its_reach():
     X1[1, :3, :3] = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]  # turned 0.01 rad
     assert shifted(X0, X1, np.array([1.0, 0.2])) == pytest.approx([0.005, 0.002], abs=1e-9)
     assert shifted(X0, X0, np.array([1.0, 0.2])) == pytest.approx([0.0, 0.0], abs=1e-6)
+
+
+def test_the_time_asleep_sums_each_sleep_to_its_wake_and_the_last_to_the_end():
+    sleeper = ContentsSleep(plant=None, scene_graph=None, spheres=[], radius=0.008, others=[],
+                            config=None, events=[(0.5, "sleep"), (2.0, "wake"), (3.0, "sleep")])
+    assert sleeper.asleep_time(4.25) == pytest.approx(1.5 + 1.25)
+    assert ContentsSleep(None, None, [], 0.008, [], None).asleep_time(4.25) == 0.0

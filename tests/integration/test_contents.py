@@ -4,7 +4,8 @@ A full cup standing on the table keeps its spheres (asleep once they rest, awake
 cup is pushed); the same cup turned upside down above the
 table by a test rig (the cup welded to a link on a PD-driven revolute joint) pours them all onto
 the table; the dispenser drops its spheres into an empty bowl standing below it, and keeps them
-while its gate is closed (opened while they sleep on it, it wakes them). Counts are those of `count_contents`, the task check's.
+while its gate is closed (opened while they sleep on it, it wakes them). Counts are those of
+`count_contents`, the task check's.
 """
 
 import numpy as np

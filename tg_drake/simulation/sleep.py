@@ -13,10 +13,12 @@ let such bodies sleep; Drake does not, so the simulation loop does it between st
   `wake_margin` [m] of a sphere). Then every sphere's joint is locked (SAP drops its degrees of
   freedom) and its contacts are filtered (a transient collision filter in the scene graph's
   context: no contact surface is computed for it). They stay exactly where they lay.
-- **Awake** again, at the first check after: a body near them moves faster than
-  `sleep_speed`, or a body that was near when they fell asleep (the container they lie in, the
-  bowl) has moved or turned by `wake_shift` [m] at its bounding sphere. The filter is removed and
-  the joints unlocked; they go on from rest where they lay.
+- **Awake** again, at the first check after: a body near them moves faster than `wake_speed`
+  [m/s], or a body that was near when they fell asleep (the container they lie in, the bowl) has
+  moved or turned by `wake_shift` [m] at its bounding sphere. The filter is removed and the
+  joints unlocked; they go on from rest where they lay. (`wake_speed` is above `sleep_speed`: a
+  light container relieved of its contents' weight settles back on its compliant support by a
+  fraction of a millimetre, slowly, and that alone should not wake them.)
 
 All spheres sleep and wake together: one sphere resting on another never loses its support.
 The full check runs every `sleep_period` [s] of simulated time; while they sleep, the bodies
@@ -127,7 +129,7 @@ class ContentsSleep:
     events: list = field(default_factory=list)
 
     @classmethod
-    def for_station(cls, station, config) -> "ContentsSleep | None":
+    def for_station(cls, station, config) -> ContentsSleep | None:
         """None when the station has no spheres or `config.sleep` is off."""
         if not getattr(config, "sleep", False) or not station.contents:
             return None
@@ -168,6 +170,16 @@ class ContentsSleep:
         centres = np.einsum("kij,kj->ki", X_o[:, :3, :3], p_BC) + X_o[:, :3, 3]
         return X_s[:, :3, 3], v_s, X_o, v_o, centres, radii
 
+    def asleep_time(self, t_end: float) -> float:
+        """[s] of simulated time the spheres slept up to `t_end`."""
+        total, since = 0.0, None
+        for t, event in self.events:
+            if event == "sleep":
+                since = t
+            elif since is not None:
+                total, since = total + t - since, None
+        return total + (t_end - since if since is not None else 0.0)
+
     def _reach(self) -> np.ndarray:
         """[m] the farthest each other body's geometry lies from its origin."""
         return np.array([np.linalg.norm(o.p_BC) + o.radius for o in self.others])
@@ -183,7 +195,7 @@ class ContentsSleep:
         if self.asleep:
             moved = shifted(self.X_then[self.near_then], X_o[self.near_then],
                             reach[self.near_then]) > c.wake_shift
-            if np.any(v_o[near] > c.sleep_speed) or np.any(moved):
+            if np.any(v_o[near] > c.wake_speed) or np.any(moved):
                 self._wake(root_context, t)
             return
         if np.all(v_s < c.sleep_speed) and np.all(v_o[near] < c.sleep_speed):
@@ -196,14 +208,14 @@ class ContentsSleep:
 
     def watch(self, root_context) -> None:
         """The check after every step while they sleep: a body that was near them when they
-        fell asleep moves faster than `sleep_speed` or has moved by `wake_shift` — wake."""
+        fell asleep moves faster than `wake_speed` or has moved by `wake_shift` — wake."""
         c = self.config
         plant_context = self.plant.GetMyContextFromRoot(root_context)
         for body, reach, X_then in self.watched:
             V = self.plant.EvalBodySpatialVelocityInWorld(plant_context, body)
             X = self.plant.EvalBodyPoseInWorld(plant_context, body).GetAsMatrix4()
             if (speeds(V.translational()[None], V.rotational()[None], [reach])[0]
-                    > c.sleep_speed or shifted(X_then[None], X[None], [reach])[0] > c.wake_shift):
+                    > c.wake_speed or shifted(X_then[None], X[None], [reach])[0] > c.wake_shift):
                 self._wake(root_context, root_context.get_time())
                 return
 

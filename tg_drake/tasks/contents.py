@@ -63,6 +63,10 @@ SLEEP_SPEED = 0.002  # [m/s] still: slower than this (centre's speed + spin × r
 SLEEP_AFTER = 0.2  # [s] still this long (40 steps of 5 ms) before they sleep
 SLEEP_PERIOD = 0.05  # [s] simulated time between checks (10 steps)
 WAKE_MARGIN = 0.03  # [m] a body moving at up to 0.6 m/s crosses it between two checks
+WAKE_SPEED = 0.01  # [m/s] measured: a full glass standing on the table, its spheres asleep,
+# settles back on the compliant table top relieved of their weight (0.013 mm, its speed bound
+# 2.6 mm/s: 0.5 mm/s and a slight turn times its 0.16 m reach): with SLEEP_SPEED as the
+# threshold, sleep and wake alternated every 0.25 s
 WAKE_SHIFT = 0.001  # [m] a near body (the container they lie in) moved this far wakes them;
 # they then overlap its wall by at most that much
 
@@ -97,6 +101,7 @@ class ContentsConfig:
     sleep_after: float = SLEEP_AFTER  # [s] still this long before they sleep
     sleep_period: float = SLEEP_PERIOD  # [s] simulated time between checks
     wake_margin: float = WAKE_MARGIN  # [m] a body this near a sphere is near them
+    wake_speed: float = WAKE_SPEED  # [m/s] a near body faster than this wakes them
     wake_shift: float = WAKE_SHIFT  # [m] a near body moved this far wakes them
 
     def validate(self, where: str = "contents") -> None:
@@ -108,7 +113,7 @@ class ContentsConfig:
         for name, unit in (("radius", "m"), ("modulus", "Pa"), ("resolution_hint", "m")):
             _check_positive(getattr(self, name), f"{where}.{name}", unit)
         for name, unit in (("sleep_speed", "m/s"), ("sleep_after", "s"), ("sleep_period", "s"),
-                           ("wake_margin", "m"), ("wake_shift", "m")):
+                           ("wake_margin", "m"), ("wake_speed", "m/s"), ("wake_shift", "m")):
             _check_positive(getattr(self, name), f"{where}.{name}", unit)
         for name, unit in (("dissipation", "s/m"), ("friction", "1")):
             _check_positive(getattr(self, name), f"{where}.{name}", unit, allow_zero=True)
