@@ -52,6 +52,7 @@ from pydrake.geometry import (
     Convex,
     GeometryInstance,
     GeometrySet,
+    HalfSpace,
     InMemoryMesh,
     MakePhongIllustrationProperties,
     MakeRenderEngineGl,
@@ -105,7 +106,7 @@ from tg_drake.scenario import (
     resolve_objects,
 )
 from tg_drake.support_hull import support_hull
-from tg_drake.table import add_surfaces, add_table
+from tg_drake.table import TABLE_HEIGHT, add_surfaces, add_table
 from tg_drake.tasks.contents import (
     DISPENSER_WALL,
     ContentsConfig,
@@ -389,6 +390,39 @@ def spheres_touch_walls(plant: MultibodyPlant, scene_graph: SceneGraph,
         GeometrySet(list(walls)), GeometrySet(list(others | set(walls)))))
 
 
+CONTENTS_FLOOR = "contents_floor"  # name of the floor under the table, for the spheres
+FLOOR_FRICTION = 0.5  # [1] Coulomb friction of the floor (static = dynamic)
+FLOOR_DISSIPATION = 5.0  # [s/m] Hunt–Crossley dissipation of the floor
+
+
+def add_contents_floor(plant: MultibodyPlant, X_WT: RigidTransform):
+    """Before Finalize, in a scene with sphere contents: the floor TABLE_HEIGHT below the table
+    top, a rigid-hydroelastic half-space on the world (a sphere is compliant: their contact is a
+    surface). A sphere that leaves the table (spilled, or, rarely, shot out of a contact between
+    two rigid walls that pinch it) lands there instead of falling without end — which after a
+    few seconds ends the simulation with a non-finite pose — and `count_contents` counts it on
+    the floor. Returns its geometry id; `floor_touches_only_spheres` filters the rest."""
+    props = ProximityProperties()
+    AddContactMaterial(dissipation=FLOOR_DISSIPATION,
+                       friction=CoulombFriction(FLOOR_FRICTION, FLOOR_FRICTION), properties=props)
+    AddRigidHydroelasticProperties(props)
+    X_WF = RigidTransform(X_WT.translation() - [0.0, 0.0, TABLE_HEIGHT])  # (the table is level)
+    return plant.RegisterCollisionGeometry(plant.world_body(), X_WF, HalfSpace(), CONTENTS_FLOOR,
+                                           props)
+
+
+def floor_touches_only_spheres(plant: MultibodyPlant, scene_graph: SceneGraph,
+                               contents: list[ContentsModel], floor) -> None:
+    """Collision filters (after Finalize): the contents' floor touches the spheres only (an
+    object that falls off the table falls as it did before)."""
+    spheres = {g for m in contents for b in m.bodies
+               for g in plant.GetCollisionGeometriesForBody(plant.get_body(BodyIndex(b)))}
+    others = set(scene_graph.model_inspector().GetAllGeometryIds(Role.kProximity))
+    others -= spheres | {floor}
+    scene_graph.collision_filter_manager().Apply(CollisionFilterDeclaration().ExcludeBetween(
+        GeometrySet([floor]), GeometrySet(list(others))))
+
+
 def exclude_mutual_contact(plant: MultibodyPlant, scene_graph: SceneGraph,
                            contents: list[ContentsModel]) -> None:
     """Filters contact between any two spheres (after Finalize)."""
@@ -516,6 +550,8 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
         contents.append(dispensed)
     if receiver_of(scenario) is not None:  # a pass: the second WSG (tg_drake.receiver)
         instances[RECEIVER] = add_receiver(plant, parser, scenario)
+    # With spheres, the floor the table stands on, for them (see add_contents_floor).
+    floor = add_contents_floor(plant, X_WT) if contents else None
     walls = {}  # with spheres, each object's simplified wall for them
     for placement in scenario.objects if contents else ():
         body = plant.get_body(plant.GetBodyIndices(objects[placement.instance_name])[0])
@@ -548,6 +584,8 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
         spheres_touch_walls(plant, scene_graph, contents, walls)
     if contents and not scenario.contents.mutual:
         exclude_mutual_contact(plant, scene_graph, contents)
+    if floor is not None:
+        floor_touches_only_spheres(plant, scene_graph, contents, floor)
     if scenario.dispenser is not None:
         command = builder.AddNamedSystem("dispenser_command",
                                          DispenserCommand(gate_travel(scenario.dispenser)))

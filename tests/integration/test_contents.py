@@ -1,15 +1,17 @@
 """Contents as spheres in physics: every sphere accounted for, none through a wall.
 
 A full cup standing on the table keeps its spheres (asleep once they rest, awake again when the
-cup is pushed); the same cup turned upside down above the
-table by a test rig (the cup welded to a link on a PD-driven revolute joint) pours them all onto
-the table; the dispenser drops its spheres into an empty bowl standing below it, and keeps them
-while its gate is closed (opened while they sleep on it, it wakes them). Counts are those of
-`count_contents`, the task check's.
+cup is pushed); the same cup turned upside down above the table by a test rig (the cup welded to
+a link on a PD-driven revolute joint) pours them all onto the table; the dispenser drops its
+spheres into an empty bowl standing below it, and keeps them while its gate is closed (opened
+while they sleep on it, it wakes them). Counts are those of `count_contents`, the task check's;
+a sphere that leaves the table lands on the floor, which touches nothing else.
 """
 
 import numpy as np
 import pytest
+from pydrake.geometry import Role
+from pydrake.math import RigidTransform
 from pydrake.multibody.math import SpatialVelocity
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.analysis import Simulator
@@ -18,7 +20,8 @@ from tg_drake.objects import WATER_DENSITY, get_object
 from tg_drake.scenario import load_scenario
 from tg_drake.simulation.pour import tilt_rig
 from tg_drake.simulation.sleep import ContentsSleep, advance
-from tg_drake.station import CONTENTS_WALL, make_station
+from tg_drake.station import CONTENTS_FLOOR, CONTENTS_WALL, make_station
+from tg_drake.table import TABLE_HEIGHT, X_WT_DEFAULT
 from tg_drake.tasks.contents import ContentsConfig, count_contents
 
 CUP = "cup_01"
@@ -122,6 +125,33 @@ def test_the_spheres_touch_the_simplified_wall_and_everything_else_the_original_
     assert not inspector.CollisionFiltered(pad, original)
     assert inspector.CollisionFiltered(pad, wall)
     assert inspector.GetPoseInFrame(wall).IsExactlyEqualTo(inspector.GetPoseInFrame(original))
+
+
+def test_a_sphere_off_the_table_lands_on_the_floor_which_touches_nothing_else():
+    scenario = load_scenario(scenario_text=FULL_CUP)
+    diagram, station = make_station(scenario)
+    plant, inspector = station.plant, station.scene_graph.model_inspector()
+    (floor,) = [g for g in inspector.GetAllGeometryIds(Role.kProximity)
+                if inspector.GetName(g).endswith(CONTENTS_FLOOR)]
+    spheres = [g for b in station.contents[0].bodies
+               for g in plant.GetCollisionGeometriesForBody(plant.get_body(BodyIndex(b)))]
+    touched = [g for g in inspector.GetAllGeometryIds(Role.kProximity)
+               if g != floor and not inspector.CollisionFiltered(floor, g)]
+    assert sorted(touched) == sorted(spheres)
+    # One sphere beside the table (0.2 m past its far edge), 0.1 m above its top.
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    _hold_robot(diagram, station, context)
+    sphere = plant.get_body(BodyIndex(station.contents[0].bodies[0]))
+    x_far = X_WT_DEFAULT.translation()[0] + 0.5 * scenario.table_size[0] + 0.2
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    plant.SetFreeBodyPose(plant_context, sphere, RigidTransform([x_far, 0.0, 0.1]))
+    simulator.AdvanceTo(1.0)  # falls 0.5 m in 0.32 s, then rests on the floor
+    z = plant.EvalBodyPoseInWorld(plant_context, sphere).translation()[2]
+    radius = station.contents[0].radius
+    assert z == pytest.approx(-TABLE_HEIGHT + radius, abs=0.5 * radius)
+    (counts,) = _station_counts(diagram, station, context, {CUP: CUP})
+    assert counts["floor"] == 1 and counts[CUP] == len(station.contents[0].bodies) - 1
 
 
 def test_the_mass_model_adds_no_spheres():
