@@ -52,7 +52,6 @@ from pydrake.geometry import (
     Convex,
     GeometryInstance,
     GeometrySet,
-    HalfSpace,
     InMemoryMesh,
     MakePhongIllustrationProperties,
     MakeRenderEngineGl,
@@ -106,7 +105,13 @@ from tg_drake.scenario import (
     resolve_objects,
 )
 from tg_drake.support_hull import support_hull
-from tg_drake.table import TABLE_HEIGHT, add_surfaces, add_table
+from tg_drake.table import (
+    FLOOR_MARGIN,
+    FLOOR_THICKNESS,
+    TABLE_HEIGHT,
+    add_surfaces,
+    add_table,
+)
 from tg_drake.tasks.contents import (
     DISPENSER_WALL,
     ContentsConfig,
@@ -395,20 +400,22 @@ FLOOR_FRICTION = 0.5  # [1] Coulomb friction of the floor (static = dynamic)
 FLOOR_DISSIPATION = 5.0  # [s/m] Hunt–Crossley dissipation of the floor
 
 
-def add_contents_floor(plant: MultibodyPlant, X_WT: RigidTransform):
+def add_contents_floor(plant: MultibodyPlant, X_WT: RigidTransform, table_size):
     """Before Finalize, in a scene with sphere contents: the floor TABLE_HEIGHT below the table
-    top, a rigid-hydroelastic half-space on the world (a sphere is compliant: their contact is a
-    surface). A sphere that leaves the table (spilled, or, rarely, shot out of a contact between
-    two rigid walls that pinch it) lands there instead of falling without end — which after a
-    few seconds ends the simulation with a non-finite pose — and `count_contents` counts it on
-    the floor. Returns its geometry id; `floor_touches_only_spheres` filters the rest."""
+    top, a rigid-hydroelastic slab on the world (FLOOR_THICKNESS thick, reaching FLOOR_MARGIN
+    past each edge of the table; a sphere is compliant: their contact is a surface). A sphere
+    that leaves the table (spilled, or now and then shot out of a pinch between two rigid
+    walls) lands there instead of falling without end, and `count_contents` counts it on the
+    floor (one that leaves even the floor is frozen as a stray: tg_drake.simulation.sleep).
+    Returns its geometry id; `floor_touches_only_spheres` filters the rest."""
     props = ProximityProperties()
     AddContactMaterial(dissipation=FLOOR_DISSIPATION,
                        friction=CoulombFriction(FLOOR_FRICTION, FLOOR_FRICTION), properties=props)
     AddRigidHydroelasticProperties(props)
-    X_WF = RigidTransform(X_WT.translation() - [0.0, 0.0, TABLE_HEIGHT])  # (the table is level)
-    return plant.RegisterCollisionGeometry(plant.world_body(), X_WF, HalfSpace(), CONTENTS_FLOOR,
-                                           props)
+    size = [float(v) + 2 * FLOOR_MARGIN for v in table_size] + [FLOOR_THICKNESS]
+    X_TF = RigidTransform([0.0, 0.0, -TABLE_HEIGHT - 0.5 * FLOOR_THICKNESS])
+    return plant.RegisterCollisionGeometry(plant.world_body(), X_WT @ X_TF, Box(*size),
+                                           CONTENTS_FLOOR, props)
 
 
 def floor_touches_only_spheres(plant: MultibodyPlant, scene_graph: SceneGraph,
@@ -551,7 +558,7 @@ def add_station(builder: DiagramBuilder, *, scenario: Scenario,
     if receiver_of(scenario) is not None:  # a pass: the second WSG (tg_drake.receiver)
         instances[RECEIVER] = add_receiver(plant, parser, scenario)
     # With spheres, the floor the table stands on, for them (see add_contents_floor).
-    floor = add_contents_floor(plant, X_WT) if contents else None
+    floor = add_contents_floor(plant, X_WT, scenario.table_size) if contents else None
     walls = {}  # with spheres, each object's simplified wall for them
     for placement in scenario.objects if contents else ():
         body = plant.get_body(plant.GetBodyIndices(objects[placement.instance_name])[0])

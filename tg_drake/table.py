@@ -26,6 +26,9 @@ X_WT_DEFAULT = RigidTransform([0.75, 0.0, 0.0])
 TABLE_SIZE = (0.8, 1.2)  # [m] default top x (depth, away from the robot) × y (width)
 TABLE_THICKNESS = 0.04  # [m] of the top slab
 TABLE_HEIGHT = 0.4  # [m] table-top surface above the floor
+FLOOR_MARGIN = 1.0  # [m] how far past each edge of the table the floor reaches (it is there for
+# the contents' spheres only: station.add_contents_floor)
+FLOOR_THICKNESS = 1.0  # [m] of that floor's slab (a sphere shot down at 30 m/s still meets it)
 TABLE_MASS = 20.0  # [kg] of the top (welded to the world: it only fills the model)
 TABLE_LEG_WIDTH = 0.05  # [m] square legs
 TABLE_LEG_INSET = 0.05  # [m] from a top edge to a leg's centre line

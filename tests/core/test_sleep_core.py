@@ -4,7 +4,16 @@ are near the spheres, how far a body moved."""
 import numpy as np
 import pytest
 
-from tg_drake.simulation.sleep import ContentsSleep, near_spheres, shifted, speeds
+from tg_drake.simulation.sleep import (
+    STRAY_HEIGHT,
+    ContentsSleep,
+    inside,
+    near_spheres,
+    shifted,
+    speeds,
+    workspace,
+)
+from tg_drake.table import FLOOR_MARGIN, TABLE_HEIGHT
 
 
 def test_a_body_s_speed_bound_adds_its_spin_times_its_reach():
@@ -41,3 +50,14 @@ def test_the_time_asleep_sums_each_sleep_to_its_wake_and_the_last_to_the_end():
                             config=None, events=[(0.5, "sleep"), (2.0, "wake"), (3.0, "sleep")])
     assert sleeper.asleep_time(4.25) == pytest.approx(1.5 + 1.25)
     assert ContentsSleep(None, None, [], 0.008, [], None).asleep_time(4.25) == 0.0
+
+
+def test_the_workspace_is_the_floor_s_footprint_from_its_top_to_above_the_table():
+    X_WT = np.eye(4)
+    X_WT[:3, 3] = [0.75, 0.0, 0.0]
+    lo, hi = workspace(X_WT, (0.8, 1.2))
+    assert lo == pytest.approx([0.35 - FLOOR_MARGIN, -0.6 - FLOOR_MARGIN, -TABLE_HEIGHT - 0.05])
+    assert hi == pytest.approx([1.15 + FLOOR_MARGIN, 0.6 + FLOOR_MARGIN, STRAY_HEIGHT])
+    p = np.array([[0.75, 0.0, 0.1], [0.75, 0.0, STRAY_HEIGHT + 0.1], [0.75, 0.0, -0.5],
+                  [3.0, 0.0, 0.1]])
+    assert inside(p, lo, hi).tolist() == [True, False, False, False]

@@ -101,11 +101,41 @@ def test_resting_spheres_sleep_where_they_lie_and_wake_when_their_cup_is_pushed(
     assert not np.array_equal(_sphere_positions(station, context), p_asleep)
 
 
-def test_without_sleep_no_sleeper_is_made():
-    scenario = load_scenario(scenario_text=FULL_CUP + "contents: {model: spheres, sleep: false}\n"
-                             .replace("contents: {model: spheres}\n", ""))
-    _, station = make_station(scenario)
-    assert station.contents and ContentsSleep.for_station(station, scenario.contents) is None
+def test_without_sleep_the_spheres_never_sleep():
+    scenario = load_scenario(scenario_text=FULL_CUP.replace(
+        "contents: {model: spheres}", "contents: {model: spheres, sleep: false}"))
+    assert scenario.contents.sleep is False
+    diagram, station = make_station(scenario)
+    simulator = Simulator(diagram)
+    _hold_robot(diagram, station, simulator.get_mutable_context())
+    sleeper = ContentsSleep.for_station(station, scenario.contents)
+    advance(simulator, 1.5, sleeper)
+    assert not sleeper.asleep and sleeper.events == []
+
+
+def test_a_sphere_shot_out_of_the_workspace_is_frozen_where_it_strayed():
+    scenario = load_scenario(scenario_text=FULL_CUP)
+    diagram, station = make_station(scenario)
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    _hold_robot(diagram, station, context)
+    plant = station.plant
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    sphere = plant.get_body(BodyIndex(station.contents[0].bodies[0]))
+    # Shot up at 30 m/s from 1.9 m above the table top: out of the workspace (2 m) within a step.
+    plant.SetFreeBodyPose(plant_context, sphere, RigidTransform([0.75, 0.0, 1.9]))
+    plant.SetFreeBodySpatialVelocity(plant_context, sphere,
+                                     SpatialVelocity(w=[0.0, 0.0, 0.0], v=[0.0, 0.0, 30.0]))
+    sleeper = ContentsSleep.for_station(station, scenario.contents)
+    advance(simulator, 0.05, sleeper)  # the first check
+    assert sleeper.frozen == {0} and sleeper.events == [(0.05, "froze 1 strayed")]
+    p_frozen = plant.EvalBodyPoseInWorld(plant_context, sphere).translation()
+    assert p_frozen[2] > 2.0
+    advance(simulator, 1.5, sleeper)  # the others sleep and wake around it; it stays
+    assert np.array_equal(plant.EvalBodyPoseInWorld(plant_context, sphere).translation(),
+                          p_frozen)
+    (counts,) = _station_counts(diagram, station, context, {CUP: CUP})
+    assert counts["elsewhere"] == 1 and counts[CUP] == len(station.contents[0].bodies) - 1
 
 
 def test_the_spheres_touch_the_simplified_wall_and_everything_else_the_original_mesh():

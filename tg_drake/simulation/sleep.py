@@ -41,6 +41,8 @@ from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, Role
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.analysis import SimulatorStatus
 
+from tg_drake.table import FLOOR_MARGIN, TABLE_HEIGHT
+
 # ---------------------------------------------------------------------------------------------
 # The core: decisions on arrays.
 
@@ -73,6 +75,33 @@ def shifted(X_then: np.ndarray, X_now: np.ndarray, reach: np.ndarray) -> np.ndar
     R = np.einsum("kji,kjl->kil", X0[:, :3, :3], X1[:, :3, :3])  # R0ᵀ R1
     cos = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
     return move + np.arccos(cos) * np.asarray(reach, float)
+
+
+def inside(p: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Which points (n, 3) lie in the box [lo, hi] (world, m): a bool (n,) array."""
+    p = np.asarray(p, float).reshape(-1, 3)
+    return np.all((p >= lo) & (p <= hi), axis=1)
+
+
+def workspace(X_WT: np.ndarray, table_size) -> tuple[np.ndarray, np.ndarray]:
+    """The box [lo, hi] (world, m) the contents may be in: over the floor (the table's footprint
+    widened by FLOOR_MARGIN on every side, TABLE_HEIGHT below the top:
+    `station.add_contents_floor`), from just under the floor's top to STRAY_HEIGHT above the
+    table top. A sphere outside it has
+    strayed: shot out of a pinch between two rigid walls (now and then in a pour, at 20–30 m/s),
+    it would fly or fall without end until the simulation stopped on a non-finite pose."""
+    X_WT = np.asarray(X_WT, float)
+    half = 0.5 * np.asarray(table_size, float) + FLOOR_MARGIN
+    corners = np.array([[sx * half[0], sy * half[1], 0.0] for sx in (-1, 1) for sy in (-1, 1)])
+    xy = (corners @ X_WT[:3, :3].T + X_WT[:3, 3])[:, :2]
+    z = X_WT[2, 3]
+    lo = np.array([*xy.min(axis=0), z - TABLE_HEIGHT - STRAY_MARGIN_BELOW])
+    hi = np.array([*xy.max(axis=0), z + STRAY_HEIGHT])
+    return lo, hi
+
+
+STRAY_MARGIN_BELOW = 0.05  # [m] under the floor's top
+STRAY_HEIGHT = 2.0  # [m] above the table top
 
 
 # ---------------------------------------------------------------------------------------------
@@ -120,6 +149,9 @@ class ContentsSleep:
     radius: float  # [m] the largest sphere's
     others: list[_Bounds]  # every other body that can move and touch
     config: object  # ContentsConfig (its sleep_* fields)
+    lo: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))  # the workspace [m]
+    hi: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
+    frozen: set = field(default_factory=set)  # indices of the spheres frozen as strays
     still_since: float | None = None
     asleep: bool = False
     filter_id: object = None
@@ -130,8 +162,9 @@ class ContentsSleep:
 
     @classmethod
     def for_station(cls, station, config) -> ContentsSleep | None:
-        """None when the station has no spheres or `config.sleep` is off."""
-        if not getattr(config, "sleep", False) or not station.contents:
+        """None when the station has no spheres. With `config.sleep` off they never sleep, but
+        strays are still frozen (`workspace`)."""
+        if not station.contents:
             return None
         plant = station.plant
         inspector = station.scene_graph.model_inspector()
@@ -149,7 +182,10 @@ class ContentsSleep:
             if bounds is not None:
                 others.append(bounds)
         radius = max(m.radius for m in station.contents)
-        return cls(plant, station.scene_graph, spheres, radius, others, config)
+        scenario = station.scenario
+        lo, hi = workspace(scenario.X_WT.GetDeterministicValue().GetAsMatrix4(),
+                           scenario.table_size)
+        return cls(plant, station.scene_graph, spheres, radius, others, config, lo, hi)
 
     def _state(self, plant_context):
         poses = self.plant.get_body_poses_output_port().Eval(plant_context)
@@ -190,6 +226,12 @@ class ContentsSleep:
         t = root_context.get_time()
         plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
         p_s, v_s, X_o, v_o, centres, radii = self._state(plant_context)
+        strays = [i for i in np.flatnonzero(~inside(p_s, self.lo, self.hi))
+                  if int(i) not in self.frozen]
+        if strays:
+            self._freeze(root_context, t, strays)
+        if not c.sleep:
+            return
         near = near_spheres(p_s, self.radius, centres, radii, c.wake_margin)
         reach = self._reach()
         if self.asleep:
@@ -219,6 +261,23 @@ class ContentsSleep:
                 self._wake(root_context, root_context.get_time())
                 return
 
+    def _freeze(self, root_context, t, strays) -> None:
+        """Strays (spheres out of the workspace) locked and their contacts filtered, for good:
+        they are counted where they are (`count_contents`: the floor or elsewhere)."""
+        plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
+        sg_context = self.scene_graph.GetMyMutableContextFromRoot(root_context)
+        inspector = self.scene_graph.model_inspector()
+        everything = list(inspector.GetAllGeometryIds(Role.kProximity))
+        for i in strays:
+            body = self.spheres[int(i)]
+            body.Lock(plant_context)
+            self.scene_graph.collision_filter_manager(sg_context).ApplyTransient(
+                CollisionFilterDeclaration().ExcludeBetween(
+                    GeometrySet(self.plant.GetCollisionGeometriesForBody(body)),
+                    GeometrySet(everything)))
+            self.frozen.add(int(i))
+        self.events.append((round(float(t), 6), f"froze {len(strays)} strayed"))
+
     def _sleep(self, root_context, t, near, X_o) -> None:
         plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
         for b in self.spheres:
@@ -240,8 +299,9 @@ class ContentsSleep:
         sg_context = self.scene_graph.GetMyMutableContextFromRoot(root_context)
         self.scene_graph.collision_filter_manager(sg_context).RemoveDeclaration(self.filter_id)
         plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
-        for b in self.spheres:
-            b.Unlock(plant_context)
+        for i, b in enumerate(self.spheres):
+            if i not in self.frozen:
+                b.Unlock(plant_context)
         self.asleep, self.filter_id, self.still_since = False, None, None
         self.events.append((round(float(t), 6), "wake"))
 
@@ -258,6 +318,8 @@ def advance(simulator, t_end: float, sleeper: ContentsSleep | None) -> None:
     context = simulator.get_context()
     h = sleeper.plant.time_step()
     every = max(1, int(round(sleeper.config.sleep_period / h)))
+    if not sleeper.config.sleep:  # only the strays' check, every sleep_period
+        h, every = h * every, 1
     k = int(np.floor(context.get_time() / h + 1e-6))
     while context.get_time() < t_end - 1e-12:
         k += 1
