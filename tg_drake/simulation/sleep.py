@@ -19,6 +19,9 @@ let such bodies sleep; Drake does not, so the simulation loop does it between st
   joints unlocked; they go on from rest where they lay. (`wake_speed` is above `sleep_speed`: a
   light container relieved of its contents' weight settles back on its compliant support by a
   fraction of a millimetre, slowly, and that alone should not wake them.)
+- **Strays** (whether or not sleep is on): a sphere out of the workspace (`workspace`: over
+  the floor the station lays for the contents, up to 2 m above the table) at a full check is
+  locked and filtered for good where it is, and counted there (the floor or elsewhere).
 
 All spheres sleep and wake together: one sphere resting on another never loses its support.
 The full check runs every `sleep_period` [s] of simulated time; while they sleep, the bodies
@@ -28,7 +31,7 @@ run at fixed simulated times: a run is deterministic. While asleep the spheres' 
 press on what they lie in; nothing near them moves then, so nothing can tell. `contents:
 {sleep: false}` turns it off.
 
-    sleeper = ContentsSleep.for_station(station, root_context, scenario.contents)
+    sleeper = ContentsSleep.for_station(station, scenario.contents)  # None: no spheres
     advance(simulator, t_end, sleeper)   # simulator.AdvanceTo with the checks in between
 """
 
@@ -87,9 +90,9 @@ def workspace(X_WT: np.ndarray, table_size) -> tuple[np.ndarray, np.ndarray]:
     """The box [lo, hi] (world, m) the contents may be in: over the floor (the table's footprint
     widened by FLOOR_MARGIN on every side, TABLE_HEIGHT below the top:
     `station.add_contents_floor`), from just under the floor's top to STRAY_HEIGHT above the
-    table top. A sphere outside it has
-    strayed: shot out of a pinch between two rigid walls (now and then in a pour, at 20–30 m/s),
-    it would fly or fall without end until the simulation stopped on a non-finite pose."""
+    table top. A sphere outside it has strayed: shot out of a pinch between two rigid walls (now
+    and then in a pour, at 20–30 m/s), it would fly or fall without end until the simulation
+    stopped on a non-finite pose."""
     X_WT = np.asarray(X_WT, float)
     half = 0.5 * np.asarray(table_size, float) + FLOOR_MARGIN
     corners = np.array([[sx * half[0], sy * half[1], 0.0] for sx in (-1, 1) for sy in (-1, 1)])
@@ -232,6 +235,9 @@ class ContentsSleep:
             self._freeze(root_context, t, strays)
         if not c.sleep:
             return
+        if self.frozen:  # (strays take no part in sleep and wake)
+            keep = np.array([i not in self.frozen for i in range(len(p_s))])
+            p_s, v_s = p_s[keep], v_s[keep]
         near = near_spheres(p_s, self.radius, centres, radii, c.wake_margin)
         reach = self._reach()
         if self.asleep:
