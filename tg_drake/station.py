@@ -121,6 +121,7 @@ from tg_drake.tasks.contents import (
     contents_wall,
     hopper_height,
     hopper_sites,
+    jittered,
 )
 
 WATER_DENSITY = 1000.0  # [kg/m³] contents of a "full" container
@@ -327,7 +328,9 @@ def add_spheres(plant: MultibodyPlant, instance: ModelInstanceIndex, prefix: str
                 p_W: np.ndarray, radius: float, mass: float, config: ContentsConfig,
                 visible: bool = False) -> tuple[int, ...]:
     """Free compliant-hydroelastic spheres of `radius` [m] and `mass` [kg] each at the world
-    positions p_W (n, 3), before Finalize; returns their body indices."""
+    positions p_W (n, 3) (moved by `config.start_jitter`: `tasks.contents.jittered`), before
+    Finalize; returns their body indices."""
+    p_W = jittered(p_W, config.start_jitter, config.start_seed)
     proximity = ProximityProperties()
     AddContactMaterial(dissipation=config.dissipation,
                        friction=CoulombFriction(config.friction, config.friction),

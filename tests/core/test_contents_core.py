@@ -1,5 +1,7 @@
 """The contents core: a container's cavity from its mesh, start sites, counts, and bad input."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -8,6 +10,7 @@ from tg_drake.objects import get_object, mesh
 from tg_drake.scenario import load_scenario
 from tg_drake.tasks.contents import (
     CLEARANCE,
+    LATTICE_GAP,
     WALL_TOLERANCE,
     ContentsConfig,
     ContentsModel,
@@ -18,6 +21,8 @@ from tg_drake.tasks.contents import (
     count_contents,
     enclosed,
     hopper_sites,
+    jittered,
+    max_start_jitter,
 )
 
 CUP = "cup_01"
@@ -166,3 +171,24 @@ def test_a_wall_that_cannot_be_simplified_within_its_tolerance_is_the_original()
     _, V, F = _cup()
     Vw, Fw = contents_wall(V, F, tolerance=1e-7)
     assert np.array_equal(Vw, V) and np.array_equal(Fw, F)
+
+
+def test_a_start_jitter_moves_each_sphere_within_its_bound_reproducibly_and_keeps_them_apart():
+    p = np.array([[0.0, 0.0, 0.0], [0.0168, 0.0, 0.0], [0.0, 0.0168, 0.0]])  # the lattice (r 8 mm)
+    j = max_start_jitter(0.008)
+    assert j == pytest.approx(0.008 * LATTICE_GAP / 4)
+    a, b = jittered(p, j, 3), jittered(p, j, 3)
+    assert np.array_equal(a, b) and not np.array_equal(a, p)
+    assert np.all(np.abs(a - p) <= j)
+    assert not np.array_equal(a, jittered(p, j, 4))
+    d = np.linalg.norm(a[:, None] - a[None], axis=2)[np.triu_indices(3, 1)]
+    assert d.min() > 2 * 0.008
+    assert np.array_equal(jittered(p, 0.0, 3), p)
+
+
+@pytest.mark.parametrize("field, value", [("start_jitter", -1e-5), ("start_jitter", 1e-3),
+                                          ("start_seed", -1), ("start_seed", 1.5)])
+def test_a_start_jitter_out_of_bounds_is_refused_naming_the_field(field, value):
+    with pytest.raises(ScenarioError) as e:
+        dataclasses.replace(ContentsConfig(model="spheres"), **{field: value}).validate()
+    assert e.value.field == f"contents.{field}"

@@ -71,6 +71,22 @@ WAKE_SHIFT = 0.001  # [m] a near body (the container they lie in) moved this far
 # they then overlap its wall by at most that much
 
 LATTICE_GAP = 0.05  # [1] lattice spacing = 2·radius·(1 + gap): spheres start apart
+
+
+def max_start_jitter(radius: float) -> float:
+    """[m] the largest `start_jitter` for spheres of `radius` [m]: two neighbours on the lattice
+    start 2·radius·LATTICE_GAP apart; each moved by at most this along every axis (√3 times it
+    in all), they still do not touch."""
+    return radius * LATTICE_GAP / 4.0
+
+
+def jittered(p: np.ndarray, jitter: float, seed: int) -> np.ndarray:
+    """Start positions (n, 3) [m], each moved by a uniform offset in [-jitter, jitter] along
+    each axis, drawn with `seed` (jitter 0: unchanged)."""
+    p = np.asarray(p, float)
+    if jitter <= 0.0:
+        return p
+    return p + np.random.default_rng(seed).uniform(-jitter, jitter, size=p.shape)
 CLEARANCE = 1.1  # [1] a start site is at least this many radii from the container's mesh
 ON_TABLE = 3.0  # [radii] a sphere's centre this near the table top lies on the table or on spheres
 # lying on it (one resting in the groove between two stands 2.7 radii high)
@@ -94,6 +110,11 @@ class ContentsConfig:
     friction: float = SPHERE_FRICTION  # [1] Coulomb friction (static = dynamic)
     mutual: bool = True  # the spheres touch each other (False: each touches only the rest of
     # the world, a cheaper fluid that keeps no volume)
+    # Start jitter, to measure how much an outcome owes to the spheres' exact start (a pour is
+    # chaotic: docs/design.md): each sphere's start moved by a uniform offset in
+    # [-start_jitter, start_jitter] along each axis, drawn with `start_seed`; 0: on the lattice.
+    start_jitter: float = 0.0  # [m], at most MAX_START_JITTER (the spheres start apart)
+    start_seed: int = 0
     # Resting spheres asleep (tg_drake.simulation.sleep): out of the physics while they and
     # everything near them lie still, until something near them moves.
     sleep: bool = True
@@ -117,6 +138,16 @@ class ContentsConfig:
             _check_positive(getattr(self, name), f"{where}.{name}", unit)
         for name, unit in (("dissipation", "s/m"), ("friction", "1")):
             _check_positive(getattr(self, name), f"{where}.{name}", unit, allow_zero=True)
+        _check_positive(self.start_jitter, f"{where}.start_jitter", "m", allow_zero=True)
+        if self.start_jitter > max_start_jitter(self.radius):
+            raise ScenarioError(
+                f"start_jitter {self.start_jitter} m would let spheres start overlapping; "
+                f"allowed: 0 ≤ start_jitter ≤ {max_start_jitter(self.radius):.6g} m (radius × "
+                f"LATTICE_GAP / 4)", field=f"{where}.start_jitter")
+        if not isinstance(self.start_seed, int) or isinstance(self.start_seed, bool) \
+                or self.start_seed < 0:
+            raise ScenarioError(f"start_seed must be an integer ≥ 0, got {self.start_seed!r}",
+                                field=f"{where}.start_seed")
         if self.radius > 0.05:
             raise ScenarioError(f"a sphere of radius {self.radius} m is no small contents; "
                                 "allowed: 0 < radius ≤ 0.05 [m]", field=f"{where}.radius")
