@@ -380,13 +380,18 @@ def add_contents_wall(plant: MultibodyPlant, scene_graph: SceneGraph, body, obj)
     return walls
 
 
+def sphere_geometries(plant: MultibodyPlant, contents: list[ContentsModel]) -> list:
+    """The proximity geometry ids of every sphere of `contents` (after Finalize)."""
+    return [g for m in contents for b in m.bodies
+            for g in plant.GetCollisionGeometriesForBody(plant.get_body(BodyIndex(b)))]
+
+
 def spheres_touch_walls(plant: MultibodyPlant, scene_graph: SceneGraph,
                         contents: list[ContentsModel], walls: dict) -> None:
     """Collision filters (after Finalize): the spheres touch each object's simplified wall and
     not its original mesh; every other geometry the original and not the wall."""
     inspector = scene_graph.model_inspector()
-    spheres = {g for m in contents for b in m.bodies
-               for g in plant.GetCollisionGeometriesForBody(plant.get_body(BodyIndex(b)))}
+    spheres = set(sphere_geometries(plant, contents))
     # (the originals by name: ids taken before Finalize are not kept)
     originals = [inspector.GetGeometryIdByName(inspector.GetFrameId(w), Role.kProximity, name)
                  for w, name in walls.items()]
@@ -425,10 +430,8 @@ def floor_touches_only_spheres(plant: MultibodyPlant, scene_graph: SceneGraph,
                                contents: list[ContentsModel], floor) -> None:
     """Collision filters (after Finalize): the contents' floor touches the spheres only (an
     object that falls off the table falls as it did before)."""
-    spheres = {g for m in contents for b in m.bodies
-               for g in plant.GetCollisionGeometriesForBody(plant.get_body(BodyIndex(b)))}
     others = set(scene_graph.model_inspector().GetAllGeometryIds(Role.kProximity))
-    others -= spheres | {floor}
+    others -= set(sphere_geometries(plant, contents)) | {floor}
     scene_graph.collision_filter_manager().Apply(CollisionFilterDeclaration().ExcludeBetween(
         GeometrySet([floor]), GeometrySet(list(others))))
 
@@ -436,10 +439,9 @@ def floor_touches_only_spheres(plant: MultibodyPlant, scene_graph: SceneGraph,
 def exclude_mutual_contact(plant: MultibodyPlant, scene_graph: SceneGraph,
                            contents: list[ContentsModel]) -> None:
     """Filters contact between any two spheres (after Finalize)."""
-    bodies = [plant.get_body(BodyIndex(b)) for m in contents for b in m.bodies]
-    geometries = GeometrySet([g for b in bodies for g in plant.GetCollisionGeometriesForBody(b)])
     scene_graph.collision_filter_manager().Apply(
-        CollisionFilterDeclaration().ExcludeWithin(geometries))
+        CollisionFilterDeclaration().ExcludeWithin(GeometrySet(sphere_geometries(plant,
+                                                                                 contents))))
 
 
 def _add_sphere_contents(plant: MultibodyPlant, placement: ObjectPlacement, obj,

@@ -46,10 +46,17 @@ def test_a_body_s_shift_is_its_displacement_plus_its_turn_times_its_reach():
 
 
 def test_the_time_asleep_sums_each_sleep_to_its_wake_and_the_last_to_the_end():
-    sleeper = ContentsSleep(plant=None, scene_graph=None, spheres=[], radius=0.008, others=[],
-                            config=None, events=[(0.5, "sleep"), (2.0, "wake"), (3.0, "sleep")])
-    assert sleeper.asleep_time(4.25) == pytest.approx(1.5 + 1.25)
-    assert ContentsSleep(None, None, [], 0.008, [], None).asleep_time(4.25) == 0.0
+    def sleeper(events):
+        return ContentsSleep(plant=None, scene_graph=None, spheres=[], sphere_geometries=[],
+                             radius=0.008, others=[], p_BC=np.zeros((0, 3)), radii=np.zeros(0),
+                             config=None, events=events)
+
+    assert sleeper([(0.5, "sleep"), (2.0, "wake"), (3.0, "sleep")]).asleep_time(4.25) == \
+        pytest.approx(1.5 + 1.25)
+    assert sleeper([]).asleep_time(4.25) == 0.0
+    # A stray frozen while they sleep does not end their sleep.
+    assert sleeper([(0.5, "sleep"), (1.0, "froze 1 strayed"), (2.0, "wake")]).asleep_time(
+        4.25) == pytest.approx(1.5)
 
 
 def test_the_workspace_is_the_floor_s_footprint_from_its_top_to_above_the_table():

@@ -124,16 +124,13 @@ def bounding_sphere(plant, inspector, body) -> _Bounds | None:
     """The sphere about the body's collision geometries' oriented boxes (None: no collision
     geometry, or none with a box — it touches nothing the spheres do)."""
     corners = []
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
     for g in plant.GetCollisionGeometriesForBody(body):
         obb = inspector.GetObbInGeometryFrame(g)
         if obb is None:
             continue
-        X_BG = inspector.GetPoseInFrame(g).GetAsMatrix4()
-        X_GO = obb.pose().GetAsMatrix4()
-        h = obb.half_width()
-        signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-        p_O = signs * h
-        corners.append((X_BG @ X_GO @ np.c_[p_O, np.ones(8)].T).T[:, :3])
+        X_BO = inspector.GetPoseInFrame(g).GetAsMatrix4() @ obb.pose().GetAsMatrix4()
+        corners.append((X_BO @ np.c_[signs * obb.half_width(), np.ones(8)].T).T[:, :3])
     if not corners:
         return None
     pts = np.vstack(corners)
@@ -144,70 +141,72 @@ def bounding_sphere(plant, inspector, body) -> _Bounds | None:
 @dataclass
 class ContentsSleep:
     """The spheres' sleep and wake (module doc) for one simulator's plant; `update` at each
-    check. `events` lists (simulated time [s], "sleep" | "wake") for the record."""
+    check, `watch` after each step while they sleep. `events` lists (simulated time [s],
+    "sleep" | "wake" | "froze N strayed") for the record."""
 
     plant: object
     scene_graph: object
     spheres: list  # the spheres' bodies
+    sphere_geometries: list  # each sphere's proximity geometry ids
     radius: float  # [m] the largest sphere's
-    others: list[_Bounds]  # every other body that can move and touch
-    config: object  # ContentsConfig (its sleep_* fields)
+    others: list  # every other body that can move and touch
+    p_BC: np.ndarray  # (m, 3) [m] the centres of their bounding spheres, in their frames
+    radii: np.ndarray  # (m,) [m] the radii of their bounding spheres
+    config: object  # ContentsConfig (its sleep_* and wake_* fields)
     lo: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))  # the workspace [m]
     hi: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
     frozen: set = field(default_factory=set)  # indices of the spheres frozen as strays
     still_since: float | None = None
     asleep: bool = False
     filter_id: object = None
-    near_then: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
-    X_then: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 4)))
-    watched: list = field(default_factory=list)  # (body, reach [m], X_WB at sleep) of near ones
+    near_then: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))  # when they slept
+    X_then: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 4)))  # the others then
     events: list = field(default_factory=list)
 
     @classmethod
     def for_station(cls, station, config) -> ContentsSleep | None:
         """None when the station has no spheres. With `config.sleep` off they never sleep, but
         strays are still frozen (`workspace`)."""
-        if not station.contents:
+        spheres = [station.plant.get_body(BodyIndex(b)) for m in station.contents
+                   for b in m.bodies]
+        if not spheres:
             return None
         plant = station.plant
         inspector = station.scene_graph.model_inspector()
-        spheres = [plant.get_body(BodyIndex(b)) for m in station.contents for b in m.bodies]
-        if not spheres:
-            return None
         ids = {int(b.index()) for b in spheres}
         static = {int(b.index()) for b in plant.GetBodiesWeldedTo(plant.world_body())}
-        others = []
-        for i in range(plant.num_bodies()):
-            body = plant.get_body(BodyIndex(i))
-            if i in ids or i in static:
-                continue
-            bounds = bounding_sphere(plant, inspector, body)
-            if bounds is not None:
-                others.append(bounds)
-        radius = max(m.radius for m in station.contents)
+        bounds = [bounding_sphere(plant, inspector, plant.get_body(BodyIndex(i)))
+                  for i in range(plant.num_bodies()) if i not in ids and i not in static]
+        bounds = [b for b in bounds if b is not None]
         scenario = station.scenario
         lo, hi = workspace(scenario.X_WT.GetDeterministicValue().GetAsMatrix4(),
                            scenario.table_size)
-        return cls(plant, station.scene_graph, spheres, radius, others, config, lo, hi)
+        return cls(plant, station.scene_graph, spheres,
+                   [list(plant.GetCollisionGeometriesForBody(b)) for b in spheres],
+                   max(m.radius for m in station.contents), [b.body for b in bounds],
+                   np.array([b.p_BC for b in bounds]).reshape(-1, 3),
+                   np.array([b.radius for b in bounds]), config, lo, hi)
+
+    @property
+    def reach(self) -> np.ndarray:
+        """[m] the farthest each other body's geometry lies from its origin."""
+        return np.linalg.norm(self.p_BC, axis=1) + self.radii
 
     def _state(self, plant_context):
         poses = self.plant.get_body_poses_output_port().Eval(plant_context)
         vels = self.plant.get_body_spatial_velocities_output_port().Eval(plant_context)
 
-        def arrays(bodies, reach_of):
+        def arrays(bodies, reach):
             X = np.array([poses[b.index()].GetAsMatrix4() for b in bodies]).reshape(-1, 4, 4)
             V = [vels[b.index()] for b in bodies]
             v = np.array([s.translational() for s in V]).reshape(-1, 3)
             w = np.array([s.rotational() for s in V]).reshape(-1, 3)
-            return X, speeds(v, w, reach_of)
+            return X, speeds(v, w, reach)
 
         X_s, v_s = arrays(self.spheres, np.full(len(self.spheres), self.radius))
-        bodies = [o.body for o in self.others]
-        p_BC = np.array([o.p_BC for o in self.others]).reshape(-1, 3)
-        radii = np.array([o.radius for o in self.others])
-        X_o, v_o = arrays(bodies, self._reach())
-        centres = np.einsum("kij,kj->ki", X_o[:, :3, :3], p_BC) + X_o[:, :3, 3]
-        return X_s[:, :3, 3], v_s, X_o, v_o, centres, radii
+        X_o, v_o = arrays(self.others, self.reach)
+        centres = np.einsum("kij,kj->ki", X_o[:, :3, :3], self.p_BC) + X_o[:, :3, 3]
+        return X_s[:, :3, 3], v_s, X_o, v_o, centres
 
     def asleep_time(self, t_end: float) -> float:
         """[s] of simulated time the spheres slept up to `t_end`."""
@@ -215,21 +214,17 @@ class ContentsSleep:
         for t, event in self.events:
             if event == "sleep":
                 since = t
-            elif since is not None:
+            elif event == "wake" and since is not None:
                 total, since = total + t - since, None
         return total + (t_end - since if since is not None else 0.0)
-
-    def _reach(self) -> np.ndarray:
-        """[m] the farthest each other body's geometry lies from its origin."""
-        return np.array([np.linalg.norm(o.p_BC) + o.radius for o in self.others])
 
     def update(self, root_context) -> None:
         """One check at the context's time (module doc)."""
         c = self.config
         t = root_context.get_time()
-        plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
-        p_s, v_s, X_o, v_o, centres, radii = self._state(plant_context)
-        strays = [i for i in np.flatnonzero(~inside(p_s, self.lo, self.hi))
+        p_s, v_s, X_o, v_o, centres = self._state(
+            self.plant.GetMyContextFromRoot(root_context))
+        strays = [int(i) for i in np.flatnonzero(~inside(p_s, self.lo, self.hi))
                   if int(i) not in self.frozen]
         if strays:
             self._freeze(root_context, t, strays)
@@ -238,12 +233,9 @@ class ContentsSleep:
         if self.frozen:  # (strays take no part in sleep and wake)
             keep = np.array([i not in self.frozen for i in range(len(p_s))])
             p_s, v_s = p_s[keep], v_s[keep]
-        near = near_spheres(p_s, self.radius, centres, radii, c.wake_margin)
-        reach = self._reach()
+        near = near_spheres(p_s, self.radius, centres, self.radii, c.wake_margin)
         if self.asleep:
-            moved = shifted(self.X_then[self.near_then], X_o[self.near_then],
-                            reach[self.near_then]) > c.wake_shift
-            if np.any(v_o[near] > c.wake_speed) or np.any(moved):
+            if np.any(v_o[near] > c.wake_speed) or self._moved(X_o[self.near_then]):
                 self._wake(root_context, t)
             return
         if np.all(v_s < c.sleep_speed) and np.all(v_o[near] < c.sleep_speed):
@@ -254,51 +246,52 @@ class ContentsSleep:
         else:
             self.still_since = None
 
+    def _moved(self, X_near: np.ndarray) -> bool:
+        """Has a body that was near them when they fell asleep (poses X_near, in the order of
+        `near_then`) moved or turned by `wake_shift`?"""
+        i = np.flatnonzero(self.near_then)
+        return bool(np.any(shifted(self.X_then[i], X_near, self.reach[i])
+                           > self.config.wake_shift))
+
     def watch(self, root_context) -> None:
         """The check after every step while they sleep: a body that was near them when they
         fell asleep moves faster than `wake_speed` or has moved by `wake_shift` — wake."""
-        c = self.config
         plant_context = self.plant.GetMyContextFromRoot(root_context)
-        for body, reach, X_then in self.watched:
-            V = self.plant.EvalBodySpatialVelocityInWorld(plant_context, body)
-            X = self.plant.EvalBodyPoseInWorld(plant_context, body).GetAsMatrix4()
-            if (speeds(V.translational()[None], V.rotational()[None], [reach])[0]
-                    > c.wake_speed or shifted(X_then[None], X[None], [reach])[0] > c.wake_shift):
-                self._wake(root_context, root_context.get_time())
-                return
+        i = np.flatnonzero(self.near_then)
+        bodies = [self.others[k] for k in i]
+        V = [self.plant.EvalBodySpatialVelocityInWorld(plant_context, b) for b in bodies]
+        v = np.array([s.translational() for s in V]).reshape(-1, 3)
+        w = np.array([s.rotational() for s in V]).reshape(-1, 3)
+        X = np.array([self.plant.EvalBodyPoseInWorld(plant_context, b).GetAsMatrix4()
+                      for b in bodies]).reshape(-1, 4, 4)
+        if np.any(speeds(v, w, self.reach[i]) > self.config.wake_speed) or self._moved(X):
+            self._wake(root_context, root_context.get_time())
+
+    def _filter(self, root_context, geometries):
+        """A transient filter in the scene graph's context: `geometries` touch nothing."""
+        sg_context = self.scene_graph.GetMyMutableContextFromRoot(root_context)
+        everything = self.scene_graph.model_inspector().GetAllGeometryIds(Role.kProximity)
+        return self.scene_graph.collision_filter_manager(sg_context).ApplyTransient(
+            CollisionFilterDeclaration().ExcludeBetween(GeometrySet(geometries),
+                                                        GeometrySet(list(everything))))
 
     def _freeze(self, root_context, t, strays) -> None:
         """Strays (spheres out of the workspace) locked and their contacts filtered, for good:
         they are counted where they are (`count_contents`: the floor or elsewhere)."""
         plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
-        sg_context = self.scene_graph.GetMyMutableContextFromRoot(root_context)
-        inspector = self.scene_graph.model_inspector()
-        everything = list(inspector.GetAllGeometryIds(Role.kProximity))
         for i in strays:
-            body = self.spheres[int(i)]
-            body.Lock(plant_context)
-            self.scene_graph.collision_filter_manager(sg_context).ApplyTransient(
-                CollisionFilterDeclaration().ExcludeBetween(
-                    GeometrySet(self.plant.GetCollisionGeometriesForBody(body)),
-                    GeometrySet(everything)))
-            self.frozen.add(int(i))
+            self.spheres[i].Lock(plant_context)
+            self.frozen.add(i)
+        self._filter(root_context, [g for i in strays for g in self.sphere_geometries[i]])
         self.events.append((round(float(t), 6), f"froze {len(strays)} strayed"))
 
     def _sleep(self, root_context, t, near, X_o) -> None:
         plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
         for b in self.spheres:
             b.Lock(plant_context)
-        sg_context = self.scene_graph.GetMyMutableContextFromRoot(root_context)
-        inspector = self.scene_graph.model_inspector()
-        mine = [g for b in self.spheres for g in self.plant.GetCollisionGeometriesForBody(b)]
-        everything = list(inspector.GetAllGeometryIds(Role.kProximity))
-        self.filter_id = self.scene_graph.collision_filter_manager(sg_context).ApplyTransient(
-            CollisionFilterDeclaration().ExcludeBetween(GeometrySet(mine),
-                                                        GeometrySet(everything)))
+        self.filter_id = self._filter(root_context,
+                                      [g for gs in self.sphere_geometries for g in gs])
         self.asleep, self.near_then, self.X_then = True, near.copy(), X_o.copy()
-        reach = self._reach()
-        self.watched = [(self.others[i].body, float(reach[i]), X_o[i])
-                        for i in np.flatnonzero(near)]
         self.events.append((round(float(t), 6), "sleep"))
 
     def _wake(self, root_context, t) -> None:

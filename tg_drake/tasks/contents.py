@@ -71,6 +71,11 @@ WAKE_SHIFT = 0.001  # [m] a near body (the container they lie in) moved this far
 # they then overlap its wall by at most that much
 
 LATTICE_GAP = 0.05  # [1] lattice spacing = 2·radius·(1 + gap): spheres start apart
+CLEARANCE = 1.1  # [1] a start site is at least this many radii from the container's mesh
+ON_TABLE = 3.0  # [radii] a sphere's centre this near the table top lies on the table or on spheres
+# lying on it (one resting in the groove between two stands 2.7 radii high)
+_PAIRS = 400_000  # ray-triangle pairs per vectorised batch (memory: ~10 MB per array)
+_HORIZONTAL = 12  # rays in O's xy plane for the enclosure test
 
 
 def max_start_jitter(radius: float) -> float:
@@ -87,11 +92,6 @@ def jittered(p: np.ndarray, jitter: float, seed: int) -> np.ndarray:
     if jitter <= 0.0:
         return p
     return p + np.random.default_rng(seed).uniform(-jitter, jitter, size=p.shape)
-CLEARANCE = 1.1  # [1] a start site is at least this many radii from the container's mesh
-ON_TABLE = 3.0  # [radii] a sphere's centre this near the table top lies on the table or on spheres
-# lying on it (one resting in the groove between two stands 2.7 radii high)
-_PAIRS = 400_000  # ray-triangle pairs per vectorised batch (memory: ~10 MB per array)
-_HORIZONTAL = 12  # rays in O's xy plane for the enclosure test
 
 
 @dataclass
@@ -113,7 +113,7 @@ class ContentsConfig:
     # Start jitter, to measure how much an outcome owes to the spheres' exact start (a pour is
     # chaotic: docs/design.md): each sphere's start moved by a uniform offset in
     # [-start_jitter, start_jitter] along each axis, drawn with `start_seed`; 0: on the lattice.
-    start_jitter: float = 0.0  # [m], at most MAX_START_JITTER (the spheres start apart)
+    start_jitter: float = 0.0  # [m], at most max_start_jitter(radius) (the spheres start apart)
     start_seed: int = 0
     # Resting spheres asleep (tg_drake.simulation.sleep): out of the physics while they and
     # everything near them lie still, until something near them moves.
